@@ -1,0 +1,188 @@
+//! Step 2 of METHOD.md §5: decode the photo into scene radiance, and mark clipped pixels.
+//!
+//! 8- and 16-bit images are sRGB-encoded and decoded with the exact sRGB curve; floating-point
+//! images (OpenEXR, Radiance HDR) are already linear. Both are divided by the exposure.
+//! A pixel at the encoding's maximum in any channel is clipped: its radiance is only a lower
+//! bound.
+
+use std::path::Path;
+
+use image::DynamicImage;
+
+use crate::{Error, Result};
+
+/// A decoded photo. Pixels are stored row by row, row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct Photo {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear scene radiance per pixel (RGB), already divided by the exposure.
+    pub radiance: Vec<[f32; 3]>,
+    /// True where any channel sits at the encoding's maximum (only a lower bound is known).
+    pub clipped: Vec<bool>,
+    /// The sRGB-encoded colour in [0, 1] per pixel, as a person sees it: what superpixels and
+    /// seeds are computed on. For floating-point photos, the radiance times the exposure,
+    /// clamped to [0, 1] and sRGB-encoded.
+    pub display: Vec<[f32; 3]>,
+    /// True when the file held floating-point (linear, unclipped) values.
+    pub is_linear_float: bool,
+}
+
+/// The exact sRGB decoding curve (IEC 61966-2-1).
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The exact sRGB encoding curve, the inverse of [`srgb_to_linear`].
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.0031308 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+impl Photo {
+    /// Number of pixels.
+    pub fn len(&self) -> usize {
+        self.radiance.len()
+    }
+
+    /// True for a photo without pixels (never produced by [`load`]).
+    pub fn is_empty(&self) -> bool {
+        self.radiance.is_empty()
+    }
+
+    /// Index of pixel (column `x`, row `y`).
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        y as usize * self.width as usize + x as usize
+    }
+
+    /// Builds a photo from sRGB-encoded values in [0, 1] (as an 8-bit file would hold them,
+    /// divided by 255), marking values at 1 as clipped.
+    pub fn from_display(width: u32, height: u32, display: Vec<[f32; 3]>, exposure: f32) -> Self {
+        let radiance = display
+            .iter()
+            .map(|p| p.map(|c| srgb_to_linear(c) / exposure))
+            .collect();
+        let clipped = display.iter().map(|p| p.iter().any(|&c| c >= 1.0)).collect();
+        Photo {
+            width,
+            height,
+            radiance,
+            clipped,
+            display,
+            is_linear_float: false,
+        }
+    }
+
+    /// Builds a photo from linear radiance values (as a floating-point file would hold them,
+    /// before division by the exposure). Nothing is clipped.
+    pub fn from_linear(width: u32, height: u32, linear: Vec<[f32; 3]>, exposure: f32) -> Self {
+        let display = linear
+            .iter()
+            .map(|p| p.map(|c| linear_to_srgb(c.clamp(0.0, 1.0))))
+            .collect();
+        let radiance = linear.iter().map(|p| p.map(|c| c / exposure)).collect();
+        let clipped = vec![false; linear.len()];
+        Photo {
+            width,
+            height,
+            radiance,
+            clipped,
+            display,
+            is_linear_float: true,
+        }
+    }
+}
+
+/// Reads and decodes the photo at `path`; `exposure` divides the linear values (METHOD §2).
+pub fn load(path: &Path, exposure: f32) -> Result<Photo> {
+    if !(exposure.is_finite() && exposure > 0.0) {
+        return Err(Error::Usage(format!(
+            "--exposure must be a positive number, not {exposure}"
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?;
+    if reader.format().is_none() {
+        return Err(Error::photo(
+            path,
+            "not a photo format streaklight reads (PNG, JPEG, TIFF, OpenEXR, Radiance HDR)",
+        ));
+    }
+    let image = reader
+        .decode()
+        .map_err(|e| Error::photo(path, format!("cannot decode the photo: {e}")))?;
+    from_image(image, exposure).map_err(|message| Error::photo(path, message))
+}
+
+/// Converts a decoded image to a [`Photo`], choosing the decoding by the sample type.
+pub fn from_image(image: DynamicImage, exposure: f32) -> std::result::Result<Photo, String> {
+    let (width, height) = (image.width(), image.height());
+    if width == 0 || height == 0 {
+        return Err("the photo has no pixels".into());
+    }
+    match image {
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {
+            let rgb = image.into_rgb32f();
+            let linear: Vec<[f32; 3]> = rgb.pixels().map(|p| p.0).collect();
+            if linear.iter().flatten().any(|c| !c.is_finite()) {
+                return Err("the photo holds NaN or infinite values".into());
+            }
+            Ok(Photo::from_linear(
+                width,
+                height,
+                linear.into_iter().map(|p| p.map(|c| c.max(0.0))).collect(),
+                exposure,
+            ))
+        }
+        DynamicImage::ImageLuma16(_)
+        | DynamicImage::ImageLumaA16(_)
+        | DynamicImage::ImageRgb16(_)
+        | DynamicImage::ImageRgba16(_) => {
+            let rgb = image.into_rgb16();
+            let display = rgb
+                .pixels()
+                .map(|p| p.0.map(|c| c as f32 / 65535.0))
+                .collect();
+            Ok(Photo::from_display(width, height, display, exposure))
+        }
+        _ => {
+            let rgb = image.into_rgb8();
+            let display = rgb.pixels().map(|p| p.0.map(|c| c as f32 / 255.0)).collect();
+            Ok(Photo::from_display(width, height, display, exposure))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_curve_round_trips_and_matches_known_points() {
+        // 0.5 encoded is 0.21404 linear (IEC 61966-2-1 tables).
+        assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
+        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
+        for i in 0..=255 {
+            let c = i as f32 / 255.0;
+            assert!((linear_to_srgb(srgb_to_linear(c)) - c).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn clipped_pixels_are_marked_and_exposure_divides() {
+        let p = Photo::from_display(2, 1, vec![[1.0, 0.2, 0.2], [0.5, 0.5, 0.5]], 2.0);
+        assert_eq!(p.clipped, vec![true, false]);
+        assert!((p.radiance[1][0] - 0.214_041 / 2.0).abs() < 1e-5);
+    }
+}
