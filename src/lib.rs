@@ -16,6 +16,7 @@
 
 pub mod error;
 pub mod optics;
+pub mod output_file;
 pub mod photo_in;
 pub mod random;
 

@@ -1,14 +1,31 @@
-//! The `streaklight` command: parses arguments and calls the library.
+//! The `streaklight` command: parses arguments and calls the library. No logic lives here.
 
 use std::process::ExitCode;
 
 use clap::Parser;
 
+mod cli;
+
 #[derive(Parser)]
-#[command(name = "streaklight", version, about = "Fit rectangle area lights to the reflections of lights on night water")]
-enum Command {}
+#[command(
+    name = "streaklight",
+    version,
+    about = "Fit rectangle area lights to the reflections of lights on night water, and write them into a glTF scene"
+)]
+enum Command {
+    /// Find the streaks (reflections of lights) in a photo and draw pictures of every stage.
+    Segment(cli::segment::Args),
+}
 
 fn main() -> ExitCode {
-    let _ = Command::parse();
-    ExitCode::SUCCESS
+    let result = match Command::parse() {
+        Command::Segment(args) => cli::segment::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

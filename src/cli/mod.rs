@@ -1,0 +1,3 @@
+//! One file per subcommand: its arguments and a `run` that calls the library.
+
+pub mod segment;
