@@ -105,7 +105,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
     let source = document::read(path)?;
     let doc = &source.document;
     let err = |m: String| Error::scene(path, m);
-    let instances = nodes::world_instances(doc).map_err(err)?;
+    let instances = nodes::world_instances(doc, &source.json).map_err(err)?;
 
     let camera = choose_camera(doc, &instances, options.camera.as_deref()).map_err(err)?;
     let (cam_node, cam_world, yfov, aspect) = camera;

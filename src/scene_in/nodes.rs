@@ -1,6 +1,7 @@
 //! The node hierarchy baked to world space, in f64.
 
-use glam::DMat4;
+use glam::{DMat4, DQuat, DVec3};
+use serde_json::Value;
 
 /// One appearance of a node in the scene, with its world matrix.
 #[derive(Clone, Debug)]
@@ -17,7 +18,7 @@ const MAX_DEPTH: usize = 256;
 
 /// Every node instance of the document's default scene (or its first scene; or, with no
 /// scenes at all, every node that is nobody's child), parents before children, in file order.
-pub fn world_instances(doc: &gltf::Document) -> Result<Vec<NodeInstance>, String> {
+pub fn world_instances(doc: &gltf::Document, json: &Value) -> Result<Vec<NodeInstance>, String> {
     let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
         None => {
@@ -32,13 +33,35 @@ pub fn world_instances(doc: &gltf::Document) -> Result<Vec<NodeInstance>, String
     };
     let mut out = Vec::new();
     for root in roots {
-        visit(root, DMat4::IDENTITY, 0, &mut out)?;
+        visit(root, json, DMat4::IDENTITY, 0, &mut out)?;
     }
     Ok(out)
 }
 
+/// The node's local matrix in f64, read from the JSON: the `gltf` crate stores translations
+/// as f32, which at 1e5 m from the origin loses centimetres.
+fn local_matrix(node: &gltf::Node, json: &Value) -> DMat4 {
+    let obj = json.pointer(&format!("/nodes/{}", node.index()));
+    let numbers = |key: &str, n: usize| -> Option<Vec<f64>> {
+        let arr = obj?.get(key)?.as_array()?;
+        let v: Vec<f64> = arr.iter().filter_map(Value::as_f64).collect();
+        (v.len() == n && v.iter().all(|x| x.is_finite())).then_some(v)
+    };
+    if let Some(m) = numbers("matrix", 16) {
+        return DMat4::from_cols_slice(&m);
+    }
+    let t = numbers("translation", 3).map_or(DVec3::ZERO, |v| DVec3::new(v[0], v[1], v[2]));
+    let r = numbers("rotation", 4)
+        .map(|v| DQuat::from_xyzw(v[0], v[1], v[2], v[3]))
+        .and_then(|q| (q.length_squared() > 0.0).then(|| q.normalize()))
+        .unwrap_or(DQuat::IDENTITY);
+    let s = numbers("scale", 3).map_or(DVec3::ONE, |v| DVec3::new(v[0], v[1], v[2]));
+    DMat4::from_scale_rotation_translation(s, r, t)
+}
+
 fn visit(
     node: gltf::Node,
+    json: &Value,
     parent: DMat4,
     depth: usize,
     out: &mut Vec<NodeInstance>,
@@ -49,15 +72,13 @@ fn visit(
             node.index()
         ));
     }
-    let local = node.transform().matrix();
-    let local = DMat4::from_cols_array_2d(&local.map(|c| c.map(f64::from)));
-    let world = parent * local;
+    let world = parent * local_matrix(&node, json);
     out.push(NodeInstance {
         node: node.index(),
         world,
     });
     for child in node.children() {
-        visit(child, world, depth + 1, out)?;
+        visit(child, json, world, depth + 1, out)?;
     }
     Ok(())
 }
