@@ -53,7 +53,7 @@ impl TestScene {
     }
 
     fn add_view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -190,11 +190,11 @@ impl TestScene {
         let mut j = self.json.clone();
         j["buffers"] = json!([{"byteLength": self.bin.len()}]);
         let mut json_bytes = serde_json::to_vec(&j).unwrap();
-        while json_bytes.len() % 4 != 0 {
+        while !json_bytes.len().is_multiple_of(4) {
             json_bytes.push(b' ');
         }
         let mut bin = self.bin.clone();
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
