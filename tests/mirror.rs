@@ -59,7 +59,7 @@ fn flat_water_mirrors_a_light_at_the_rows_geometry_predicts() {
     assert!(top_row < bottom_row && left_col < right_col);
 
     let at = |x: u32, y: u32| image.pixels[(y * w + x) as usize][0] as f64;
-    let centre_col = (w / 2) as u32;
+    let centre_col = w / 2;
     // Every row strictly inside the predicted span is lit, every row well outside is dark.
     for y in 0..h {
         let v = at(centre_col, y);
