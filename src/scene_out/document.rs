@@ -167,8 +167,12 @@ fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value> {
         .iter()
         .rposition(|&b| b != 0 && b != b' ')
         .map_or(0, |p| p + 1);
-    serde_json::from_slice(&bytes[..end])
-        .map_err(|e| Error::scene(path, format!("not a glTF file: its JSON does not parse: {e}")))
+    serde_json::from_slice(&bytes[..end]).map_err(|e| {
+        Error::scene(
+            path,
+            format!("not a glTF file: its JSON does not parse: {e}"),
+        )
+    })
 }
 
 fn check_is_gltf2(path: &Path, json: &Value) -> Result<()> {
@@ -207,7 +211,11 @@ pub fn gltf_bytes(json: &Value) -> Result<Vec<u8>> {
 
 /// A `.glb` file: the JSON chunk (compact, space-padded), the BIN chunk if any (zero-padded),
 /// then the other chunks as they were.
-pub fn glb_bytes(json: &Value, bin: Option<&[u8]>, other_chunks: &[(u32, Vec<u8>)]) -> Result<Vec<u8>> {
+pub fn glb_bytes(
+    json: &Value,
+    bin: Option<&[u8]>,
+    other_chunks: &[(u32, Vec<u8>)],
+) -> Result<Vec<u8>> {
     let json_text = serde_json::to_vec(json)
         .map_err(|e| Error::Usage(format!("cannot serialise the glTF JSON: {e}")))?;
     let mut chunks: Vec<(u32, &[u8], u8)> = vec![(CHUNK_JSON, &json_text, b' ')];
@@ -222,8 +230,11 @@ pub fn glb_bytes(json: &Value, bin: Option<&[u8]>, other_chunks: &[(u32, Vec<u8>
             .iter()
             .map(|(_, d, _)| CHUNK_HEADER_LEN + padded_len(d.len()))
             .sum::<usize>();
-    let total32 = u32::try_from(total)
-        .map_err(|_| Error::Usage(format!("the GLB would be {total} bytes, over the 4 GiB limit")))?;
+    let total32 = u32::try_from(total).map_err(|_| {
+        Error::Usage(format!(
+            "the GLB would be {total} bytes, over the 4 GiB limit"
+        ))
+    })?;
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(&GLB_MAGIC.to_le_bytes());
     out.extend_from_slice(&GLB_VERSION.to_le_bytes());
@@ -261,7 +272,10 @@ mod tests {
         let doc = read(&path).unwrap();
         assert_eq!(doc.format, Format::Glb);
         assert_eq!(doc.json, json);
-        assert_eq!(doc.bin_chunk.as_deref(), Some(&[1u8, 2, 3, 4, 5, 0, 0, 0][..]));
+        assert_eq!(
+            doc.bin_chunk.as_deref(),
+            Some(&[1u8, 2, 3, 4, 5, 0, 0, 0][..])
+        );
         assert_eq!(doc.other_chunks, vec![(0x1234_5678, vec![9u8, 8, 7, 0])]);
         std::fs::remove_dir_all(&dir).unwrap();
     }

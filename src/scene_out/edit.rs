@@ -11,7 +11,10 @@ use serde_json::{Map, Value};
 use crate::{Error, Result};
 
 /// The root object of the document (checked to be an object when it was read).
-pub(crate) fn root_mut<'a>(json: &'a mut Value, input: &Path) -> Result<&'a mut Map<String, Value>> {
+pub(crate) fn root_mut<'a>(
+    json: &'a mut Value,
+    input: &Path,
+) -> Result<&'a mut Map<String, Value>> {
     json.as_object_mut()
         .ok_or_else(|| Error::scene(input, "not a glTF file: the JSON is not an object"))
 }

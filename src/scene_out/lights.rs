@@ -31,7 +31,11 @@ pub(crate) struct PreparedLight {
 }
 
 /// Checks `light` and converts it; `index` is its position in the caller's list, for messages.
-pub(crate) fn prepare(light: &LightToWrite, index: usize, nits_scale: f64) -> Result<PreparedLight> {
+pub(crate) fn prepare(
+    light: &LightToWrite,
+    index: usize,
+    nits_scale: f64,
+) -> Result<PreparedLight> {
     let bad = |msg: String| {
         Error::Usage(format!(
             "light {index} (\"{}\") cannot be written: {msg}",

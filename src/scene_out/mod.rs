@@ -12,9 +12,15 @@
 //! |---|---|---|
 //! | `.glb` with a BIN chunk | `.glb` | appended to the BIN chunk (buffer 0 grows) |
 //! | `.glb` with a BIN chunk | `.gltf` | the BIN chunk + new data become `<out>.streaklight.bin`, buffer 0's `uri` |
-//! | no BIN-chunk buffer, no buffers | `.glb` | a new BIN chunk, new buffer 0 |
-//! | no BIN-chunk buffer, buffers with URIs | `.glb` | a new buffer with a `data:` URI (buffer 0 must stay where it is) |
+//! | buffer 0 is a `data:` URI | `.glb` | buffer 0's bytes move into the BIN chunk (its `uri` is dropped), new data appended |
+//! | no buffers | `.glb` | a new BIN chunk, new buffer 0 |
+//! | buffer 0 is an external file | `.glb` | a new buffer, external file `<out>.streaklight.bin` |
 //! | no BIN-chunk buffer | `.gltf` | a new buffer, external file `<out>.streaklight.bin` |
+//!
+//! A `data:` URI is never used for new data: the glTF-Validator warns about `data:` URIs in a
+//! GLB (`DATA_URI_GLB`), and in a `.gltf` a base64 copy is a third larger than the file. Only
+//! buffer 0 can live in the BIN chunk (GLB spec), so the input's other `data:` buffers and
+//! images stay as they are, and a `.glb` written from such a `.gltf` keeps those warnings.
 //!
 //! When the output goes to another folder than the input, relative buffer and image URIs are
 //! rewritten to reach the original files (see [`resources`]); nothing is copied.
@@ -100,13 +106,11 @@ pub struct UriRewrite {
     pub to: String,
 }
 
-/// How a buffer that this writer created or moved is stored.
+/// How a buffer that this writer created is stored.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum BufferStorage {
     /// The BIN chunk of the output `.glb`.
     GlbBinChunk,
-    /// A base64 `data:` URI inside the JSON.
-    DataUri,
     /// An external file written next to the output.
     ExternalFile(PathBuf),
 }
@@ -116,8 +120,8 @@ pub enum BufferStorage {
 pub enum NewData {
     /// There was none (no lights, or fallback quads off).
     Nothing,
-    /// Appended to the end of an existing buffer (the input GLB's BIN-chunk buffer), whose
-    /// earlier bytes are unchanged.
+    /// Appended to the end of buffer 0 (the input GLB's BIN-chunk buffer, or a `data:` buffer 0
+    /// moved into the output GLB's BIN chunk), whose earlier bytes are unchanged.
     AppendedToBuffer {
         /// The buffer's index.
         buffer: usize,
@@ -143,6 +147,9 @@ pub struct ResourceHandling {
     pub new_data: NewData,
     /// For a `.glb` input written as `.gltf`: the file that now holds its BIN chunk (buffer 0).
     pub bin_chunk_moved_to: Option<PathBuf>,
+    /// For a `.glb` output whose input's buffer 0 was a `data:` URI: its bytes (unchanged)
+    /// now are the BIN chunk, and its `uri` was removed.
+    pub data_uri_buffer0_moved_to_bin_chunk: bool,
     /// GLB chunks of unknown type dropped because a `.gltf` output cannot hold them (readers
     /// ignore such chunks), plus a BIN chunk no buffer referred to.
     pub dropped_glb_chunks: usize,
@@ -188,7 +195,9 @@ pub fn write_lit_scene(
         .map(|(i, l)| lights::prepare(l, i, options.nits_scale))
         .collect::<Result<Vec<_>>>()?;
     let doc = document::read(input)?;
-    let input_dir = folder_of(input).canonicalize().map_err(|e| Error::io(input, e))?;
+    let input_dir = folder_of(input)
+        .canonicalize()
+        .map_err(|e| Error::io(input, e))?;
     let output_dir = folder_of(output).canonicalize().map_err(|_| {
         Error::output(
             output,
@@ -203,7 +212,17 @@ pub fn write_lit_scene(
         .ok_or_else(|| Error::output(output, "the output file name is not valid UTF-8"))?;
 
     let mut json = doc.json.clone();
-    let buffer0 = bin_chunk_buffer(&doc, input)?;
+    let bin_buffer0 = bin_chunk_buffer(&doc, input)?;
+    let unused_bin_chunk = doc.bin_chunk.is_some() && bin_buffer0.is_none();
+    let mut data_uri_moved = false;
+    let buffer0 = match bin_buffer0 {
+        None if out_format == Format::Glb => {
+            let moved = take_data_uri_buffer0(&mut json, input)?;
+            data_uri_moved = moved.is_some();
+            moved
+        }
+        other => other,
+    };
     let local = resources::local_resources(&json, &input_dir);
     let rewritten_uris = if input_dir == output_dir {
         Vec::new()
@@ -217,7 +236,9 @@ pub fn write_lit_scene(
     } else {
         Vec::new()
     };
-    let placed = place_new_data(root, buffer0, quad_bytes, out_format, &bin_name, &bin_path, input)?;
+    let placed = place_new_data(
+        root, buffer0, quad_bytes, out_format, &bin_name, &bin_path, input,
+    )?;
 
     // Check every output against every input before writing anything.
     let mut inputs: Vec<&Path> = vec![input];
@@ -236,7 +257,8 @@ pub fn write_lit_scene(
             rewritten_uris,
             new_data: placed.new_data.clone(),
             bin_chunk_moved_to: placed.bin_chunk_moved_to.clone(),
-            dropped_glb_chunks: 0,
+            data_uri_buffer0_moved_to_bin_chunk: data_uri_moved,
+            dropped_glb_chunks: usize::from(unused_bin_chunk),
             files_written: Vec::new(),
         },
     };
@@ -249,8 +271,6 @@ pub fn write_lit_scene(
     }
 
     let mut other_chunks = doc.other_chunks.clone();
-    let unused_bin = usize::from(doc.bin_chunk.is_some() && !placed.had_bin_buffer0);
-    summary.resources.dropped_glb_chunks = unused_bin;
     let out_bytes = match out_format {
         Format::Glb => document::glb_bytes(&json, placed.glb_bin.as_deref(), &other_chunks)?,
         Format::Gltf => {
@@ -317,6 +337,54 @@ fn bin_chunk_buffer(doc: &Document, input: &Path) -> Result<Option<Vec<u8>>> {
     Ok(Some(bytes.to_vec()))
 }
 
+/// For a `.glb` output: when buffer 0 is a base64 `data:` URI, removes the URI and returns
+/// the buffer's bytes, which become the BIN chunk. Same index, same bytes, and no
+/// `DATA_URI_GLB` warning for it.
+fn take_data_uri_buffer0(json: &mut Value, input: &Path) -> Result<Option<Vec<u8>>> {
+    let Some(buffer) = json
+        .pointer_mut("/buffers/0")
+        .and_then(Value::as_object_mut)
+    else {
+        return Ok(None);
+    };
+    let Some(uri) = buffer.get("uri").and_then(Value::as_str) else {
+        return Ok(None);
+    };
+    let Some(payload) = uri
+        .strip_prefix("data:")
+        .and_then(|rest| rest.split_once(','))
+        .filter(|(header, _)| header.ends_with(";base64"))
+        .map(|(_, data)| data)
+    else {
+        return Ok(None);
+    };
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(payload)
+        .map_err(|e| {
+            Error::scene(
+                input,
+                format!("buffer 0's data: URI is not valid base64: {e}"),
+            )
+        })?;
+    let len = buffer
+        .get("byteLength")
+        .and_then(Value::as_u64)
+        .and_then(|l| usize::try_from(l).ok())
+        .filter(|&l| l <= bytes.len())
+        .ok_or_else(|| {
+            Error::scene(
+                input,
+                format!(
+                    "buffer 0's \"byteLength\" is missing or over its {} bytes of data",
+                    bytes.len()
+                ),
+            )
+        })?;
+    // shift_remove keeps the order of the other keys (remove would swap the last one in).
+    buffer.shift_remove("uri");
+    Ok(Some(bytes[..len].to_vec()))
+}
+
 /// The outcome of [`place_new_data`].
 struct Placement {
     /// Buffer index and byte offset of the quad data, if there is any.
@@ -327,7 +395,6 @@ struct Placement {
     /// The bytes of `<out>.streaklight.bin`, for a `.gltf` output that needs it.
     external: Option<Vec<u8>>,
     bin_chunk_moved_to: Option<PathBuf>,
-    had_bin_buffer0: bool,
 }
 
 /// Decides where the new binary data goes (see the table in the module docs) and edits the
@@ -341,7 +408,6 @@ fn place_new_data(
     bin_path: &Path,
     input: &Path,
 ) -> Result<Placement> {
-    let had_bin_buffer0 = buffer0.is_some();
     if let Some(mut bytes) = buffer0 {
         let mut quads_at = None;
         let mut new_data = NewData::Nothing;
@@ -374,7 +440,6 @@ fn place_new_data(
                 glb_bin: Some(bytes),
                 external: None,
                 bin_chunk_moved_to: None,
-                had_bin_buffer0,
             },
             Format::Gltf => Placement {
                 quads_at,
@@ -382,7 +447,6 @@ fn place_new_data(
                 glb_bin: None,
                 external: Some(bytes),
                 bin_chunk_moved_to: Some(bin_path.to_path_buf()),
-                had_bin_buffer0,
             },
         });
     }
@@ -392,7 +456,6 @@ fn place_new_data(
         glb_bin: None,
         external: None,
         bin_chunk_moved_to: None,
-        had_bin_buffer0,
     };
     if new.is_empty() {
         return Ok(placement);
@@ -400,22 +463,13 @@ fn place_new_data(
     let index = len_of(root, "buffers");
     let (buffer, storage) = match format {
         // A buffer without a URI must be buffers[0] (GLB spec), so only an empty list may
-        // get a BIN chunk; otherwise indices would have to move.
+        // get a BIN chunk; otherwise indices would have to move. An external buffer 0 stays
+        // external, and so does our data.
         Format::Glb if index == 0 => (
             json!({ "byteLength": new.len(), "name": "streaklight" }),
             BufferStorage::GlbBinChunk,
         ),
-        Format::Glb => {
-            let uri = format!(
-                "data:application/octet-stream;base64,{}",
-                base64::engine::general_purpose::STANDARD.encode(&new)
-            );
-            (
-                json!({ "byteLength": new.len(), "uri": uri, "name": "streaklight" }),
-                BufferStorage::DataUri,
-            )
-        }
-        Format::Gltf => (
+        Format::Glb | Format::Gltf => (
             json!({ "byteLength": new.len(), "uri": bin_name, "name": "streaklight" }),
             BufferStorage::ExternalFile(bin_path.to_path_buf()),
         ),
@@ -425,7 +479,6 @@ fn place_new_data(
     match storage {
         BufferStorage::GlbBinChunk => placement.glb_bin = Some(new),
         BufferStorage::ExternalFile(_) => placement.external = Some(new),
-        BufferStorage::DataUri => {}
     }
     placement.new_data = NewData::NewBuffer {
         buffer: index,
@@ -471,7 +524,9 @@ fn target_scene(root: &mut serde_json::Map<String, Value>, input: &Path) -> Resu
             .as_u64()
             .and_then(|s| usize::try_from(s).ok())
             .filter(|&s| s < count)
-            .ok_or_else(|| Error::scene(input, format!("\"scene\": {scene} is not a scene index")));
+            .ok_or_else(|| {
+                Error::scene(input, format!("\"scene\": {scene} is not a scene index"))
+            });
     }
     if count > 0 {
         return Ok(0);

@@ -26,7 +26,10 @@ pub(crate) struct LocalResource {
 /// Every buffer and image of `json` stored in a local file, resolved against `base_dir`.
 pub(crate) fn local_resources(json: &Value, base_dir: &Path) -> Vec<LocalResource> {
     let mut out = Vec::new();
-    for (kind, key) in [(ResourceKind::Buffer, "buffers"), (ResourceKind::Image, "images")] {
+    for (kind, key) in [
+        (ResourceKind::Buffer, "buffers"),
+        (ResourceKind::Image, "images"),
+    ] {
         let Some(items) = json.get(key).and_then(Value::as_array) else {
             continue;
         };
@@ -69,10 +72,7 @@ pub(crate) fn rewrite_uris(
             )
         })?;
         // Keep a query or fragment the original URI had (rare, but it is part of the URI).
-        let suffix = res
-            .uri
-            .find(['?', '#'])
-            .map_or("", |at| &res.uri[at..]);
+        let suffix = res.uri.find(['?', '#']).map_or("", |at| &res.uri[at..]);
         let new_uri = format!("{}{suffix}", encode_path(&relative));
         let key = match res.kind {
             ResourceKind::Buffer => "buffers",
@@ -199,14 +199,20 @@ mod tests {
 
     #[test]
     fn uris_decode_and_encode() {
-        assert_eq!(relative_file_path("data:application/octet-stream;base64,AA"), None);
+        assert_eq!(
+            relative_file_path("data:application/octet-stream;base64,AA"),
+            None
+        );
         assert_eq!(relative_file_path("https://example.com/a.bin"), None);
         assert_eq!(relative_file_path("/abs.bin"), None);
         assert_eq!(
             relative_file_path("tex/my%20image.png"),
             Some(PathBuf::from("tex/my image.png"))
         );
-        assert_eq!(relative_file_path("100%.bin"), Some(PathBuf::from("100%.bin")));
+        assert_eq!(
+            relative_file_path("100%.bin"),
+            Some(PathBuf::from("100%.bin"))
+        );
         assert_eq!(encode_path("../a b/c:d.png"), "../a%20b/c%3Ad.png");
         assert_eq!(normalise(Path::new("/a/./b/../c")), PathBuf::from("/a/c"));
     }
