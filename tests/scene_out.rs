@@ -754,6 +754,16 @@ fn check_output(
     assert_lights_read_back(output, lights, options, s);
     assert_matches_schema(output, s);
     assert_valid(input, output);
+    // The `gltf` crate's own validation (the scene loader's reader) accepts the output
+    // whenever it accepted the input: no extensionsRequired, indices in range.
+    let accepts = |p: &Path| gltf::Gltf::from_slice(&std::fs::read(p).unwrap()).is_ok();
+    if accepts(input) {
+        assert!(
+            accepts(output),
+            "{}: rejected by the gltf crate",
+            output.display()
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -768,6 +778,12 @@ fn generated_scenes_every_format_same_and_other_folder() {
         assert!(
             validator_problems(&input).is_empty(),
             "{}: fixture invalid",
+            input.display()
+        );
+        let bytes = std::fs::read(&input).unwrap();
+        assert!(
+            gltf::Gltf::from_slice(&bytes).is_ok(),
+            "{}: the gltf crate refuses the fixture",
             input.display()
         );
         let stem = input.file_stem().unwrap().to_str().unwrap().to_string();

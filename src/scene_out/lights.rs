@@ -95,7 +95,8 @@ fn rotation(normal: DVec3, up: DVec3) -> [f64; 4] {
     let q = DQuat::from_mat3(&DMat3::from_cols(x, y, z)).normalize();
     // q and -q are the same rotation; pick w >= 0 so the output does not depend on rounding.
     let q = if q.w < 0.0 { -q } else { q };
-    q.to_array()
+    // Adding +0.0 turns -0.0 into 0.0, so the file never shows a "-0.0".
+    q.to_array().map(|c| c + 0.0)
 }
 
 /// The top-level light object. Every field is written: importers' defaults differ (Babylon
@@ -158,6 +159,17 @@ mod tests {
         assert!((q * DVec3::Y - up).length() < 1e-12);
         assert!((q * DVec3::X - up.cross(-normal)).length() < 1e-12);
         assert!(p.rotation[3] >= 0.0);
+        // A half turn about an axis in the XY plane has w = 0: written as 0.0, not -0.0.
+        let half = prepare(
+            &light(DVec3::new(0.0, -0.6, 0.8), DVec3::new(0.0, 0.8, 0.6)),
+            0,
+            1.0,
+        );
+        assert!(half
+            .unwrap()
+            .rotation
+            .iter()
+            .all(|c| !(*c == 0.0 && c.is_sign_negative())));
     }
 
     #[test]
