@@ -23,6 +23,7 @@ pub mod random;
 pub mod render;
 pub mod samples;
 pub mod scene_in;
+pub mod scene_out;
 pub mod tracing;
 pub mod water_mask;
 
