@@ -25,14 +25,11 @@ pub struct EdgeEstimate {
 /// lands, measured in units of the rectangle's half sizes (so a long light does not claim every
 /// pixel for its short sides). The paper maps streak sides to light sides once and for all;
 /// with waves a streak's top pixel can look past a light's side edge, so this decides per
-/// pixel. `None` for a footprint with no sample on the plane, and for one centred inside the
-/// rectangle: such a pixel (the rim of a dark ripple band inside the streak, say) sees mostly
-/// the light's inside and says little about any edge.
+/// pixel. A dim pixel centred inside the rectangle goes to the nearest edge: it says that
+/// edge is too far out (an initial rectangle that is too large must be able to shrink). `None`
+/// for a footprint with no sample on the plane.
 pub fn assign(fp: &Footprint, rect: &Rect) -> Option<EdgeSide> {
     let c = fp.centroid()?;
-    if rect.contains(c) {
-        return None;
-    }
     let centre = rect.center();
     let half = Vec2::new(rect.width(), rect.height()).max(Vec2::splat(1e-6)) * 0.5;
     let d = (c - centre) / half;
@@ -70,7 +67,14 @@ pub fn solve_edge(fp: &Footprint, rect: &Rect, side: EdgeSide, coef: f32) -> Opt
         EdgeSide::Bottom => (1.0, false),
         EdgeSide::Top => (-1.0, false),
     };
-    let held = rect.with_edge(side, if sign > 0.0 { f32::NEG_INFINITY } else { f32::INFINITY });
+    let held = rect.with_edge(
+        side,
+        if sign > 0.0 {
+            f32::NEG_INFINITY
+        } else {
+            f32::INFINITY
+        },
+    );
     let mut relevant: Vec<(f32, f32)> = fp
         .points
         .iter()
@@ -130,7 +134,10 @@ pub fn combine(estimates: &[EdgeEstimate]) -> Option<f32> {
         .iter()
         .filter(|e| (e.position - median).abs() <= limit)
         .fold((0f64, 0f64), |(s, ws), e| {
-            (s + e.position as f64 * e.weight as f64, ws + e.weight as f64)
+            (
+                s + e.position as f64 * e.weight as f64,
+                ws + e.weight as f64,
+            )
         });
     (wsum > 0.0).then(|| (sum / wsum) as f32)
 }

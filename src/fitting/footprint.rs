@@ -10,19 +10,23 @@ use super::light_plane::{reflected_sample, LightPlane};
 use super::rect::Rect;
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
-use crate::render::{trace, SceneHit};
 use crate::scene_in::Scene;
+use crate::tracing::Hit;
 
 /// Stream tag of the footprints' random numbers: distinct from the renderer's (which uses the
 /// bare pixel index), so a fit of a photo rendered with the same seed does not reuse the
 /// photo's own noise.
 const FOOTPRINT_STREAM: u64 = 2 << 48;
 
-/// The samples of one pixel that landed on the plane.
+/// The samples of one pixel (or of a small box of pixels around it) that landed on the plane.
 #[derive(Clone, Debug, Default)]
 pub struct Footprint {
-    /// Pixel index (`y * width + x`).
+    /// Pixel index (`y * width + x`) of the box's centre.
     pub pixel: u32,
+    /// The box is the (2 radius + 1)^2 pixels centred on `pixel`: camera rays are jittered
+    /// uniformly over all of it, so the footprint models the box's mean value
+    /// ([`Footprint::observed`]).
+    pub radius: u32,
     /// Plane coordinates of the samples that hit the plane first.
     pub points: Vec<Vec2>,
     /// Their lobe weights (`f cos / pdf`, Fresnel included).
@@ -51,6 +55,26 @@ impl Footprint {
         (sum / self.samples.max(1) as f64) as f32
     }
 
+    /// The photo's value this footprint models: the mean radiance over its box.
+    pub fn observed(&self, photo: &crate::photo_in::Photo) -> [f32; 3] {
+        let (w, r) = (photo.width, self.radius as i32);
+        let mut sum = [0f32; 3];
+        let mut count = 0;
+        for dy in -r..=r {
+            for dx in -r..=r {
+                if let Some(q) = super::observation::neighbour(self.pixel, dx, dy, w, photo.height)
+                {
+                    let c = photo.radiance[q as usize];
+                    for k in 0..3 {
+                        sum[k] += c[k];
+                    }
+                    count += 1;
+                }
+            }
+        }
+        sum.map(|s| s / count.max(1) as f32)
+    }
+
     /// The weighted mean landing point: where the lobe's centre lands. `None` without hits.
     pub fn centroid(&self) -> Option<Vec2> {
         let total: f32 = self.weights.iter().sum();
@@ -66,51 +90,90 @@ impl Footprint {
     }
 }
 
-/// Computes the footprints of `pixels` on `plane`, `samples` lobe samples each, in parallel.
+/// Computes the footprints of `probes` (centre pixel, box radius) on `plane`, `samples` lobe
+/// samples each, in parallel.
 /// Each pixel draws from its own random stream (seed, pixel), so the result does not depend on
 /// the number of threads.
 pub fn footprints(
     scene: &Scene,
     model: &ReflectionModel,
     plane: &LightPlane,
-    pixels: &[u32],
+    probes: &[(u32, u32)],
     width: u32,
     height: u32,
     samples: u32,
     seed: u64,
 ) -> Vec<Footprint> {
-    pixels
+    probes
         .par_iter()
-        .map(|&pixel| footprint(scene, model, plane, pixel, width, height, samples, seed))
+        .map(|&(pixel, radius)| {
+            footprint(
+                scene,
+                model,
+                plane,
+                (pixel, radius),
+                width,
+                height,
+                samples,
+                seed,
+            )
+        })
         .collect()
 }
 
-/// The footprint of one pixel. Mirrors the renderer's pixel sample: a jittered camera ray
-/// that misses the water, or a lobe sample below the surface, counts as a sample of weight 0.
+/// The footprint of one pixel box (`probe` = centre pixel, radius; the box must lie inside the
+/// image). Mirrors the renderer's pixel sample: a jittered camera ray that misses the water,
+/// or a lobe sample below the surface, counts as a sample of weight 0.
 #[allow(clippy::too_many_arguments)]
 pub fn footprint(
     scene: &Scene,
     model: &ReflectionModel,
     plane: &LightPlane,
-    pixel: u32,
+    probe: (u32, u32),
     width: u32,
     height: u32,
     samples: u32,
     seed: u64,
 ) -> Footprint {
-    let mut rng = Rng::new(seed, FOOTPRINT_STREAM | pixel as u64);
+    let (pixel, radius) = probe;
+    let mut rng = Rng::new(
+        seed,
+        FOOTPRINT_STREAM | (radius as u64) << 40 | pixel as u64,
+    );
     let (x, y) = (pixel % width, pixel / width);
     let mut fp = Footprint {
         pixel,
+        radius,
         samples,
         ..Default::default()
     };
+    let side = 2 * radius + 1;
     for _ in 0..samples {
-        let Some((start, sample)) = reflected_sample(scene, model, x, y, width, height, &mut rng)
+        // The box's pixels are equally likely: the mean of their values is modelled.
+        let (bx, by) = if radius == 0 {
+            (x, y)
+        } else {
+            let k = rng.next_u32() % (side * side);
+            (
+                (x + k % side).saturating_sub(radius),
+                (y + k / side).saturating_sub(radius),
+            )
+        };
+        let Some((start, sample)) = reflected_sample(scene, model, bx, by, width, height, &mut rng)
         else {
             continue;
         };
-        if let SceneHit::Surface(hit) = trace(scene, start, sample.wi, 0.0) {
+        // A ray that cannot reach the plane cannot land on it: no need to trace it, and one
+        // that can need not look beyond it.
+        let towards = -sample.wi.dot(plane.normal);
+        if towards <= 0.0 {
+            continue;
+        }
+        let t_plane = (start - plane.point).dot(plane.normal) / towards;
+        if t_plane <= 0.0 {
+            continue;
+        }
+        if let Some(hit) = first_surface(scene, start, sample.wi, t_plane * 1.001 + 1e-3) {
             if plane.contains_triangle(scene, hit.triangle) {
                 fp.points.push(plane.coords(start + sample.wi * hit.t));
                 fp.weights.push(sample.weight);
@@ -118,4 +181,12 @@ pub fn footprint(
         }
     }
     fp
+}
+
+/// The closest triangle hit before `tmax` (bounded, so the traversal skips everything beyond
+/// the plane). Area lights already in the scene are not geometry and do not occlude: the fit
+/// asks what a light on the plane would show, and an existing light coplanar with its wall
+/// must not hide the wall (it would, by rounding, for about half the rays).
+fn first_surface(scene: &Scene, origin: glam::Vec3, dir: glam::Vec3, tmax: f32) -> Option<Hit> {
+    scene.tracer.closest_hit(origin, dir, 0.0, tmax)
 }

@@ -24,6 +24,7 @@ pub mod observation;
 pub mod radiance;
 pub mod rect;
 mod single;
+pub mod threshold;
 
 use std::time::Instant;
 
@@ -32,6 +33,7 @@ use glam::DVec3;
 pub use light_plane::LightPlane;
 pub use observation::{StreakObservation, StreakSide};
 pub use rect::Rect;
+pub use threshold::threshold_streaks;
 
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -235,7 +237,9 @@ pub fn fit_paper(
         )));
     }
     if options.samples == 0 {
-        return Err(Error::Usage("the fit needs at least one sample per pixel".into()));
+        return Err(Error::Usage(
+            "the fit needs at least one sample per pixel".into(),
+        ));
     }
     for s in streaks {
         let bad = s
@@ -252,46 +256,41 @@ pub fn fit_paper(
         }
     }
     let mut times = single::StageTimes::default();
-    let mut fitted: Vec<(StreakObservation, FittedLight)> = Vec::new();
     let mut skipped = Vec::new();
-    for obs in streaks {
+    let mut warnings = Vec::new();
+    let t = Instant::now();
+    // Which fragments belong together is decided on a coarse fit (an eighth of the samples:
+    // plenty to see whether two rectangles overlap), so that merged streaks are traced in
+    // full only once.
+    let groups: Vec<(StreakObservation, Vec<usize>)> = if streaks.len() > 1 {
+        let coarse = FitOptions {
+            samples: (options.samples / 8).max(32),
+            ..*options
+        };
+        let mut scratch = single::StageTimes::default();
+        let mut fitted: Vec<(StreakObservation, FittedLight)> = Vec::new();
+        for obs in streaks {
+            match single::fit_streak(scene, photo, water, obs, &coarse, &mut scratch) {
+                Ok(light) => fitted.push((obs.clone(), light)),
+                Err(s) => skipped.push(s),
+            }
+        }
+        merge_fragments(scene, photo, water, &coarse, fitted, &mut warnings)
+    } else {
+        streaks.iter().map(|s| (s.clone(), vec![s.id])).collect()
+    };
+    let fragments_seconds = t.elapsed().as_secs_f64();
+    let mut lights = Vec::new();
+    for (obs, ids) in &groups {
         match single::fit_streak(scene, photo, water, obs, options, &mut times) {
-            Ok(light) => fitted.push((obs.clone(), light)),
+            Ok(mut light) => {
+                light.streak_ids = ids.clone();
+                lights.push(light);
+            }
             Err(s) => skipped.push(s),
         }
     }
-    let t = Instant::now();
-    let mut warnings = Vec::new();
-    let mut fragment_fit = single::StageTimes::default();
-    loop {
-        let lights: Vec<FittedLight> = fitted.iter().map(|f| f.1.clone()).collect();
-        let Some((i, j)) = fragments::overlapping_pair(&lights) else {
-            break;
-        };
-        let (obs_j, light_j) = fitted.remove(j);
-        let (obs_i, light_i) = fitted.remove(i);
-        let mut ids: Vec<usize> = light_i.streak_ids.iter().chain(&light_j.streak_ids).copied().collect();
-        ids.sort_unstable();
-        let merged = fragments::merge(&obs_i, &obs_j, photo);
-        match merged.map(|m| {
-            let fit = single::fit_streak(scene, photo, water, &m, options, &mut fragment_fit);
-            (m, fit)
-        }) {
-            Some((m, Ok(mut light))) => {
-                light.streak_ids = ids;
-                fitted.insert(i, (m, light));
-            }
-            _ => {
-                warnings.push(format!(
-                    "streaks {ids:?} overlap on one face but their union could not be fitted; \
-                     kept the fit of streak {}",
-                    obs_i.id
-                ));
-                fitted.insert(i, (obs_i, light_i));
-            }
-        }
-    }
-    for (_, light) in &fitted {
+    for light in &lights {
         if light.plane.hit_fraction < 0.5 {
             warnings.push(format!(
                 "streak {:?}: only {:.0} % of the brightest pixel's reflected rays hit the light's \
@@ -301,16 +300,66 @@ pub fn fit_paper(
             ));
         }
     }
-    let fragments_seconds = t.elapsed().as_secs_f64();
     Ok(FitOutcome {
-        lights: fitted.into_iter().map(|f| f.1).collect(),
+        lights,
         skipped,
         warnings,
         timings: vec![
             ("plane".into(), times.plane),
             ("footprints".into(), times.footprints),
             ("solve".into(), times.solve),
-            ("fragments".into(), fragments_seconds),
+            ("fragments (coarse fit and merge)".into(), fragments_seconds),
         ],
     })
+}
+
+/// Merges, until none is left, pairs of fitted fragments on one face whose rectangles
+/// overlap, refitting each union; returns the final groups' observations with the ids of the
+/// streaks in each.
+fn merge_fragments(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    options: &FitOptions,
+    mut fitted: Vec<(StreakObservation, FittedLight)>,
+    warnings: &mut Vec<String>,
+) -> Vec<(StreakObservation, Vec<usize>)> {
+    let mut scratch = single::StageTimes::default();
+    loop {
+        let lights: Vec<FittedLight> = fitted.iter().map(|f| f.1.clone()).collect();
+        let Some((i, j)) = fragments::overlapping_pair(&lights) else {
+            break;
+        };
+        let (obs_j, light_j) = fitted.remove(j);
+        let (obs_i, light_i) = fitted.remove(i);
+        let mut ids: Vec<usize> = light_i
+            .streak_ids
+            .iter()
+            .chain(&light_j.streak_ids)
+            .copied()
+            .collect();
+        ids.sort_unstable();
+        let refit = fragments::merge(&obs_i, &obs_j, photo).map(|m| {
+            let fit = single::fit_streak(scene, photo, water, &m, options, &mut scratch);
+            (m, fit)
+        });
+        match refit {
+            Some((m, Ok(mut light))) => {
+                light.streak_ids = ids;
+                fitted.insert(i, (m, light));
+            }
+            _ => {
+                warnings.push(format!(
+                    "streaks {} and {} overlap on one face but their union could not be \
+                     fitted; kept streak {} alone",
+                    obs_i.id, obs_j.id, obs_i.id
+                ));
+                fitted.insert(i, (obs_i, light_i));
+            }
+        }
+    }
+    fitted
+        .into_iter()
+        .map(|(obs, light)| (obs, light.streak_ids))
+        .collect()
 }

@@ -23,15 +23,17 @@ pub struct StageTimes {
     pub solve: f64,
 }
 
-/// At most this many radiance/edge alternations; they usually settle in 5-10.
-const MAX_ITERATIONS: usize = 40;
+/// At most this many radiance/edge alternations; they usually settle in 5-10 (pixels switching
+/// edges can leave a cycle of a millimetre or so, which this cuts short).
+const MAX_ITERATIONS: usize = 25;
 /// Stop when no edge moved by more than this fraction of the rectangle's size.
-const TOLERANCE: f32 = 1e-4;
+const TOLERANCE: f32 = 5e-4;
 /// Fewer valid edge pixels than this leave an edge unconstrained.
 const MIN_EDGE_PIXELS: usize = 3;
-/// An edge is unconstrained when more than this fraction of its pixels sit where the streak
-/// is cut by the photo's border or the water's end.
-const MAX_TRUNCATED_FRACTION: f32 = 0.25;
+/// An edge is flagged unconstrained when more than this fraction of its pixels sit where the
+/// streak is cut by the photo's border or the water's end (a stray pixel touching the border
+/// does not count): the pixels left may not reach the light's real edge.
+const MAX_TRUNCATED_FRACTION: f32 = 0.1;
 
 /// A streak-edge pixel and its footprint.
 struct EdgePixel {
@@ -64,22 +66,23 @@ pub fn fit_streak(
         options.seed,
     );
     times.plane += t.elapsed().as_secs_f64();
-    let plane = match search {
-        PlaneSearch::Found(p) => p,
-        PlaneSearch::Nothing { rays, water_hits } => {
-            let (x, y) = (obs.brightest % w, obs.brightest / w);
-            return Err(Skipped::NoPlane {
-                streak: obs.id,
-                message: format!(
+    let plane =
+        match search {
+            PlaneSearch::Found(p) => p,
+            PlaneSearch::Nothing { rays, water_hits } => {
+                let (x, y) = (obs.brightest % w, obs.brightest / w);
+                return Err(Skipped::NoPlane {
+                    streak: obs.id,
+                    message: format!(
                     "streak {} (brightest pixel x {x}, y {y}): none of the {rays} reflected rays \
                      hit anything but {}; add the geometry the light hangs on (a wall, facade \
                      or pole) to the scene",
                     obs.id,
                     if water_hits > 0 { "the water" } else { "the sky" }
                 ),
-            });
-        }
-    };
+                });
+            }
+        };
 
     // Pixels to trace: every streak-edge pixel and the brightest interior ones.
     let mut edge_pixels: Vec<(u32, bool, [bool; 4])> = Vec::new();
@@ -89,7 +92,8 @@ pub fn fit_streak(
                 continue;
             }
             let truncated = side.outward_neighbours().iter().any(|&(dx, dy)| {
-                neighbour(p, dx, dy, w, h).is_none_or(|q| !water.get(q as usize).copied().unwrap_or(false))
+                neighbour(p, dx, dy, w, h)
+                    .is_none_or(|q| !water.get(q as usize).copied().unwrap_or(false))
             });
             let mut sides = [false; 4];
             sides[*side as usize] = true;
@@ -109,14 +113,32 @@ pub fn fit_streak(
             false
         }
     });
-    let bright = bright_pixels(obs, photo, RADIANCE_PIXELS);
+    let bright = bright_pixels(obs, photo, water, RADIANCE_PIXELS);
     if bright.is_empty() {
         return Err(Skipped::NoSolution {
             streak: obs.id,
-            message: format!("streak {}: every pixel is clipped; lower the exposure", obs.id),
+            message: format!(
+                "streak {}: no 3 x 3 block of unclipped water pixels inside it (too thin, or \
+                 clipped: lower the exposure)",
+                obs.id
+            ),
         });
     }
-    let mut traced: Vec<u32> = edge_pixels.iter().map(|e| e.0).chain(bright.iter().copied()).collect();
+    // Edge pixels are fitted by the mean of their 3 x 3 box where it is all usable water: a
+    // streak's edge pixels are selected by their own noisy values (above the extraction's
+    // threshold, their outward neighbours below it), and the box mixes both, so the selection
+    // bias mostly cancels (on Table 1, single pixels put every edge 1-5 cm too far out).
+    let usable = |q: u32| water[q as usize] && !photo.clipped[q as usize];
+    let box_radius = |p: u32| {
+        let inside =
+            (-1..=1).all(|dy| (-1..=1).all(|dx| neighbour(p, dx, dy, w, h).is_some_and(usable)));
+        u32::from(inside)
+    };
+    let mut traced: Vec<(u32, u32)> = edge_pixels
+        .iter()
+        .map(|e| (e.0, box_radius(e.0)))
+        .chain(bright.iter().map(|&p| (p, 1)))
+        .collect();
     traced.sort_unstable();
     traced.dedup();
     let t = Instant::now();
@@ -132,22 +154,41 @@ pub fn fit_streak(
     );
     times.footprints += t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let index_of = |p: u32| traced.binary_search(&p).ok();
+    let index_of = |p: (u32, u32)| traced.binary_search(&p).ok();
     let edges: Vec<EdgePixel> = edge_pixels
         .iter()
         .filter_map(|&(p, truncated, sides)| {
-            index_of(p).map(|footprint| EdgePixel {
+            index_of((p, box_radius(p))).map(|footprint| EdgePixel {
                 footprint,
                 truncated,
                 sides,
             })
         })
         .collect();
-    let bright_fps: Vec<&Footprint> = bright.iter().filter_map(|&p| index_of(p)).map(|i| &fps[i]).collect();
+    let bright_fps: Vec<&Footprint> = bright
+        .iter()
+        .filter_map(|&p| index_of((p, 1)))
+        .map(|i| &fps[i])
+        .collect();
 
-    let result = solve(photo, obs, &fps, &edges, &bright_fps);
+    let result = solve(photo, obs, &fps, &edges, &bright_fps, true).and_then(|fit| {
+        if plausible(&fit) {
+            Ok(fit)
+        } else {
+            // With a model that does not match the photo (a wrong gloss, say) updating L from
+            // the current rectangle can run away: a smaller rectangle needs a brighter light,
+            // which makes the edges move in further. The paper's way, L from the brightest
+            // pixels with the whole plane lit and held, always settles.
+            solve(photo, obs, &fps, &edges, &bright_fps, false)
+        }
+    });
     times.solve += t.elapsed().as_secs_f64();
-    let (rect, radiance, edge_status) = result?;
+    let Solution {
+        rect,
+        radiance,
+        status: edge_status,
+        ..
+    } = result?;
     Ok(FittedLight {
         streak_ids: vec![obs.id],
         plane,
@@ -160,7 +201,15 @@ pub fn fit_streak(
     })
 }
 
-type Solution = (Rect, [f32; 3], [EdgeStatus; 4]);
+/// What the alternation settled on.
+struct Solution {
+    rect: Rect,
+    radiance: [f32; 3],
+    status: [EdgeStatus; 4],
+    /// The paper's estimate: the brightest pixels with the whole plane lit.
+    initial_radiance: [f32; 3],
+    converged: bool,
+}
 
 /// Alternates radiance and edges from an initial rectangle until they agree.
 fn solve(
@@ -169,6 +218,7 @@ fn solve(
     fps: &[Footprint],
     edges: &[EdgePixel],
     bright: &[&Footprint],
+    update_radiance: bool,
 ) -> Result<Solution, Skipped> {
     let no_solution = |what: &str| Skipped::NoSolution {
         streak: obs.id,
@@ -176,15 +226,22 @@ fn solve(
     };
     let mut rect = initial_rect(fps, edges)
         .ok_or_else(|| no_solution("no edge pixel's reflected rays reach the light's plane"))?;
-    let mut radiance = fit_radiance(photo, bright, None)
-        .ok_or_else(|| no_solution("the brightest pixels' reflected rays miss the light's plane"))?;
+    let initial_radiance = fit_radiance(photo, bright, None).ok_or_else(|| {
+        no_solution("the brightest pixels' reflected rays miss the light's plane")
+    })?;
+    let mut radiance = initial_radiance;
     let far = far_extent(fps);
-    let mut status: [EdgeStatus; 4] = std::array::from_fn(|_| EdgeStatus::Constrained { pixels: 0 });
+    let mut last_fitted = [true; 4];
+    let mut converged = false;
+    let mut status: [EdgeStatus; 4] =
+        std::array::from_fn(|_| EdgeStatus::Constrained { pixels: 0 });
     for _ in 0..MAX_ITERATIONS {
         let before = rect;
         // Who constrains what is decided once per pass, against the rectangle the pass
         // starts from.
         let mut assigned: [Vec<&EdgePixel>; 4] = Default::default();
+        // Edges with enough valid pixels to fit, even when flagged unconstrained.
+        let mut fitted = [false; 4];
         for e in edges {
             if let Some(side) = assign(&fps[e.footprint], &rect) {
                 assigned[side as usize].push(e);
@@ -205,7 +262,8 @@ fn solve(
                 EdgeStatus::Unconstrained {
                     reason: format!(
                         "the streak is cut by the photo's border or the water's end on the side \
-                         of the light's {} edge ({truncated} of {} pixels)",
+                         of the light's {} edge ({truncated} of {} pixels); fitted from the other \
+                         {valid}, which may not show the real edge",
                         side.name(),
                         pixels.len()
                     ),
@@ -213,21 +271,34 @@ fn solve(
             } else {
                 EdgeStatus::Constrained { pixels: valid }
             };
+            fitted[side as usize] = valid >= MIN_EDGE_PIXELS;
         }
+        // An edge no valid pixel constrains is placed as far as any traced pixel can see, so
+        // that it does not cut the other pixels' lobes short. `rect` keeps the last estimate,
+        // against which pixels are assigned, so that such an edge can still collect pixels.
+        let modelled = |rect: &Rect, fitted: &[bool; 4]| {
+            EdgeSide::ALL.iter().fold(*rect, |r, &s| {
+                if fitted[s as usize] {
+                    r
+                } else {
+                    r.with_edge(s, far.edge(s))
+                }
+            })
+        };
         for side in EdgeSide::ALL {
-            if let EdgeStatus::Unconstrained { .. } = status[side as usize] {
-                // The photo cannot tell where this edge is: put it as far as any traced
-                // pixel can see, so that it does not cut the other pixels' lobes short.
-                rect = rect.with_edge(side, far.edge(side));
+            if !fitted[side as usize] {
                 continue;
             }
+            let model = modelled(&rect, &fitted);
             let estimates: Vec<EdgeEstimate> = assigned[side as usize]
                 .iter()
+                // Pixels where the streak is cut are not on its edge: solving them as edge
+                // pixels pulls the edge in (tried: light1 of Table 3 came out 0.6 m short).
                 .filter(|e| !e.truncated)
                 .filter_map(|e| {
                     let fp = &fps[e.footprint];
-                    let coef = observed_coefficient(photo.radiance[fp.pixel as usize], radiance)?;
-                    solve_edge(fp, &rect, side, coef)
+                    let coef = observed_coefficient(fp.observed(photo), radiance)?;
+                    solve_edge(fp, &model, side, coef)
                 })
                 .collect();
             if let Some(x) = combine(&estimates) {
@@ -237,19 +308,47 @@ fn solve(
                 }
             }
         }
-        if let Some(l) = fit_radiance(photo, bright, Some(&rect)) {
-            radiance = l;
+        if update_radiance {
+            if let Some(l) = fit_radiance(photo, bright, Some(&modelled(&rect, &fitted))) {
+                radiance = l;
+            }
         }
+        last_fitted = fitted;
         let size = rect.width().max(rect.height());
         let moved = EdgeSide::ALL
             .iter()
             .map(|&s| (rect.edge(s) - before.edge(s)).abs())
             .fold(0.0f32, f32::max);
         if moved <= TOLERANCE * size {
+            converged = true;
             break;
         }
     }
-    Ok((rect, radiance, status))
+    let model = EdgeSide::ALL.iter().fold(rect, |r, &s| {
+        if last_fitted[s as usize] {
+            r
+        } else {
+            r.with_edge(s, far.edge(s))
+        }
+    });
+    Ok(Solution {
+        rect: model,
+        radiance,
+        status,
+        initial_radiance,
+        converged,
+    })
+}
+
+/// False for a fit that ran away: a rectangle squeezed to almost nothing, or a radiance many
+/// times the whole-plane estimate (which is a lower bound: the whole plane lit is the most a
+/// pixel can see).
+fn plausible(fit: &Solution) -> bool {
+    let peak = |l: [f32; 3]| l.iter().copied().fold(0.0f32, f32::max);
+    let size = fit.rect.width().min(fit.rect.height());
+    fit.converged
+        && size > 1e-3 * fit.rect.width().max(fit.rect.height()).max(1e-3)
+        && peak(fit.radiance) < 5.0 * peak(fit.initial_radiance)
 }
 
 /// A first rectangle, larger than the light: on each side of the streak, a far percentile of
@@ -274,7 +373,10 @@ fn initial_rect(fps: &[Footprint], edges: &[EdgePixel]) -> Option<Rect> {
         xs.sort_by(f32::total_cmp);
         Some(xs[((xs.len() - 1) as f32 * q).round() as usize])
     };
-    let all: Vec<glam::Vec2> = edges.iter().filter_map(|e| fps[e.footprint].centroid()).collect();
+    let all: Vec<glam::Vec2> = edges
+        .iter()
+        .filter_map(|e| fps[e.footprint].centroid())
+        .collect();
     let all_u: Vec<f32> = all.iter().map(|c| c.x).collect();
     let all_v: Vec<f32> = all.iter().map(|c| c.y).collect();
     let mut r = Rect {
