@@ -14,6 +14,9 @@ pub fn threshold_streaks(
     min_pixels: usize,
 ) -> Vec<StreakObservation> {
     let (w, h) = (photo.width as usize, photo.height as usize);
+    if water.len() != w * h || photo.radiance.len() != w * h || photo.clipped.len() != w * h {
+        return Vec::new();
+    }
     let peak = (0..w * h)
         .filter(|&i| water[i] && !photo.clipped[i])
         .map(|i| luminance(photo.radiance[i]))
