@@ -92,6 +92,7 @@ impl Footprint {
 
 /// Computes the footprints of `probes` (centre pixel, box radius) on `plane`, `samples` lobe
 /// samples each, in parallel.
+#[allow(clippy::too_many_arguments)]
 /// Each pixel draws from its own random stream (seed, pixel), so the result does not depend on
 /// the number of threads.
 pub fn footprints(
