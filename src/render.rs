@@ -25,7 +25,8 @@ pub struct RenderOptions {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Camera rays per pixel.
+    /// Samples per pixel: lobe samples on the water, split over jittered camera rays
+    /// (see [`camera_rays_per_pixel`]).
     pub samples_per_pixel: u32,
     /// Multiplies radiance before it is stored (the photo's exposure).
     pub exposure: f32,
@@ -142,15 +143,30 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
                 let index = y as u64 * w as u64 + x as u64;
                 let mut rng = Rng::new(options.seed, index);
                 let mut sum = [0f64; 3];
-                for _ in 0..options.samples_per_pixel {
-                    let (value, reflected_ray) =
-                        pixel_sample(scene, &model, x as u32, y as u32, w, h, &mut rng);
-                    row_reflected += reflected_ray as u64;
+                let camera_rays = camera_rays_per_pixel(options.samples_per_pixel);
+                let lobe_samples = options.samples_per_pixel / camera_rays;
+                let strata = (camera_rays as f32).sqrt() as u32;
+                for k in 0..camera_rays {
+                    let (value, traced) = pixel_sample(
+                        scene,
+                        &model,
+                        PixelSample {
+                            x: x as u32,
+                            y: y as u32,
+                            stratum: k,
+                            strata,
+                            lobe_samples,
+                        },
+                        w,
+                        h,
+                        &mut rng,
+                    );
+                    row_reflected += traced as u64;
                     for c in 0..3 {
                         sum[c] += value[c] as f64;
                     }
                 }
-                let scale = options.exposure as f64 / options.samples_per_pixel as f64;
+                let scale = options.exposure as f64 / camera_rays as f64;
                 *out = sum.map(|s| (s * scale) as f32);
             }
             reflected.fetch_add(row_reflected, Ordering::Relaxed);
@@ -161,58 +177,98 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
         width: w,
         height: h,
         pixels,
-        camera_rays: w as u64 * h as u64 * options.samples_per_pixel as u64,
+        camera_rays: w as u64 * h as u64 * camera_rays_per_pixel(options.samples_per_pixel) as u64,
         reflected_rays: reflected.into_inner(),
         seconds: start.elapsed().as_secs_f64(),
     })
 }
 
-/// One camera sample of pixel (x, y): the radiance it carries and whether a reflected ray
-/// was traced.
+/// Lobe samples traced from each camera ray's water hit. Tracing the camera ray is as costly
+/// as tracing a reflected one, and the pixel's value varies far more over the reflection lobe
+/// than over the pixel's footprint, so each camera ray is shared by a few lobe samples.
+pub const LOBE_SAMPLES_PER_CAMERA_RAY: u32 = 4;
+
+/// Camera rays per pixel for `samples_per_pixel` samples: the samples are split into camera
+/// rays of [`LOBE_SAMPLES_PER_CAMERA_RAY`] lobe samples each (one lobe sample each when there
+/// are too few samples to split).
+pub fn camera_rays_per_pixel(samples_per_pixel: u32) -> u32 {
+    if samples_per_pixel >= LOBE_SAMPLES_PER_CAMERA_RAY * 4 {
+        samples_per_pixel / LOBE_SAMPLES_PER_CAMERA_RAY
+    } else {
+        samples_per_pixel
+    }
+}
+
+/// Which camera ray of a pixel to trace.
+struct PixelSample {
+    x: u32,
+    y: u32,
+    /// Index of the camera ray within the pixel.
+    stratum: u32,
+    /// The pixel is split into strata x strata cells for the first strata^2 camera rays, so
+    /// that the footprint is covered evenly (the rest are uniformly jittered).
+    strata: u32,
+    /// Lobe samples to average at the water hit.
+    lobe_samples: u32,
+}
+
+/// One camera ray of a pixel: the mean radiance its lobe samples carry, and how many
+/// reflected rays were traced.
 fn pixel_sample(
     scene: &Scene,
     model: &ReflectionModel,
-    x: u32,
-    y: u32,
+    s: PixelSample,
     w: u32,
     h: u32,
     rng: &mut Rng,
-) -> ([f32; 3], bool) {
-    let jx = x as f32 + rng.next_f32();
-    let jy = y as f32 + rng.next_f32();
-    let u = Vec2::new(rng.next_f32(), rng.next_f32());
+) -> ([f32; 3], u32) {
+    let (mut fx, mut fy) = (rng.next_f32(), rng.next_f32());
+    if s.stratum < s.strata * s.strata {
+        let n = s.strata as f32;
+        fx = ((s.stratum % s.strata) as f32 + fx) / n;
+        fy = ((s.stratum / s.strata) as f32 + fy) / n;
+    }
     let origin = scene.camera.position;
-    let dir = scene.camera.direction(jx, jy, w, h);
+    let dir = scene
+        .camera
+        .direction(s.x as f32 + fx, s.y as f32 + fy, w, h);
     let hit = match trace(scene, origin, dir, 0.0) {
-        SceneHit::Light(i) => return (scene.area_lights[i].radiance, false),
-        SceneHit::Miss => return ([0.0; 3], false),
+        SceneHit::Light(i) => return (scene.area_lights[i].radiance, 0),
+        SceneHit::Miss => return ([0.0; 3], 0),
         SceneHit::Surface(hit) => hit,
     };
     if !scene.is_water[hit.triangle as usize] {
-        return ([0.0; 3], false);
+        return ([0.0; 3], 0);
     }
     let p = origin + dir * hit.t;
     let wo = -dir;
     let n = scene.shading_normal(hit.triangle, hit.barycentric);
-    let Some(sample) = model.sample(n, wo, u) else {
-        return ([0.0; 3], false);
-    };
     let mut face = scene.face_normal(hit.triangle);
     if face.dot(wo) < 0.0 {
         face = -face;
     }
-    // A reflected ray that would enter the water geometrically sees nothing.
-    if face.dot(sample.wi) <= 0.0 {
-        return ([0.0; 3], false);
-    }
     let start = p + face * surface_offset(p);
-    match trace(scene, start, sample.wi, 0.0) {
-        SceneHit::Light(i) => {
-            let l = scene.area_lights[i].radiance;
-            (l.map(|c| c * sample.weight), true)
+    let mut sum = [0f32; 3];
+    let mut traced = 0;
+    for _ in 0..s.lobe_samples {
+        let u = Vec2::new(rng.next_f32(), rng.next_f32());
+        let Some(sample) = model.sample(n, wo, u) else {
+            continue;
+        };
+        // A reflected ray that would enter the water geometrically sees nothing.
+        if face.dot(sample.wi) <= 0.0 {
+            continue;
         }
-        _ => ([0.0; 3], true),
+        traced += 1;
+        if let SceneHit::Light(i) = trace(scene, start, sample.wi, 0.0) {
+            let l = scene.area_lights[i].radiance;
+            for c in 0..3 {
+                sum[c] += l[c] * sample.weight;
+            }
+        }
     }
+    let inv = 1.0 / s.lobe_samples as f32;
+    (sum.map(|c| c * inv), traced)
 }
 
 fn progress_bar(enabled: bool, rows: u64) -> indicatif::ProgressBar {
