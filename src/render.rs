@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use crate::optics::{ReflectionModel, Shadowing};
 use crate::random::Rng;
-use crate::scene_in::Scene;
+use crate::scene_in::{AreaLight, Scene};
 use crate::{Error, Result};
 
 /// How to render.
@@ -83,10 +83,10 @@ pub enum SceneHit {
 /// coplanar with it; without a margin the wall would hide them by rounding.
 const LIGHT_TIE_MARGIN: f32 = 1e-4;
 
-/// Traces a ray against the scene's triangles and area lights.
-pub fn trace(scene: &Scene, origin: Vec3, dir: Vec3, tmin: f32) -> SceneHit {
+/// Traces a ray against the scene's triangles and the area lights `lights`.
+pub fn trace(scene: &Scene, lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin: f32) -> SceneHit {
     let mut nearest_light: Option<(usize, f32)> = None;
-    for (i, light) in scene.area_lights.iter().enumerate() {
+    for (i, light) in lights.iter().enumerate() {
         let limit = nearest_light.map_or(f32::INFINITY, |(_, t)| t);
         if let Some(t) = light.intersect(origin, dir, tmin, limit) {
             nearest_light = Some((i, t));
@@ -110,6 +110,15 @@ pub fn surface_offset(p: Vec3) -> f32 {
 
 /// Renders the scene's water and lights as the camera sees them.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
+    render_with_lights(scene, &scene.area_lights, options)
+}
+
+/// Renders the scene's water under `lights` instead of the scene's own (to check a fit).
+pub fn render_with_lights(
+    scene: &Scene,
+    lights: &[AreaLight],
+    options: &RenderOptions,
+) -> Result<Rendered> {
     let (w, h) = (options.width, options.height);
     if w == 0 || h == 0 || w > 32768 || h > 32768 {
         return Err(Error::Usage(format!(
@@ -149,6 +158,7 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
                 for k in 0..camera_rays {
                     let (value, traced) = pixel_sample(
                         scene,
+                        lights,
                         &model,
                         PixelSample {
                             x: x as u32,
@@ -216,6 +226,7 @@ struct PixelSample {
 /// reflected rays were traced.
 fn pixel_sample(
     scene: &Scene,
+    lights: &[AreaLight],
     model: &ReflectionModel,
     s: PixelSample,
     w: u32,
@@ -232,8 +243,8 @@ fn pixel_sample(
     let dir = scene
         .camera
         .direction(s.x as f32 + fx, s.y as f32 + fy, w, h);
-    let hit = match trace(scene, origin, dir, 0.0) {
-        SceneHit::Light(i) => return (scene.area_lights[i].radiance, 0),
+    let hit = match trace(scene, lights, origin, dir, 0.0) {
+        SceneHit::Light(i) => return (lights[i].radiance, 0),
         SceneHit::Miss => return ([0.0; 3], 0),
         SceneHit::Surface(hit) => hit,
     };
@@ -260,8 +271,8 @@ fn pixel_sample(
             continue;
         }
         traced += 1;
-        if let SceneHit::Light(i) = trace(scene, start, sample.wi, 0.0) {
-            let l = scene.area_lights[i].radiance;
+        if let SceneHit::Light(i) = trace(scene, lights, start, sample.wi, 0.0) {
+            let l = lights[i].radiance;
             for c in 0..3 {
                 sum[c] += l[c] * sample.weight;
             }
