@@ -21,6 +21,7 @@ pub mod photo_in;
 pub mod photo_out;
 pub mod random;
 pub mod render;
+pub mod report;
 pub mod samples;
 pub mod scene_in;
 pub mod scene_out;
