@@ -83,15 +83,38 @@ pub enum SceneHit {
 /// coplanar with it; without a margin the wall would hide them by rounding.
 const LIGHT_TIE_MARGIN: f32 = 1e-4;
 
-/// Traces a ray against the scene's triangles and the area lights `lights`.
-pub fn trace(scene: &Scene, lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin: f32) -> SceneHit {
-    let mut nearest_light: Option<(usize, f32)> = None;
+/// The nearest light whose emitting face the ray hits, and the distance to it.
+fn nearest_light(lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin: f32) -> Option<(usize, f32)> {
+    let mut nearest: Option<(usize, f32)> = None;
     for (i, light) in lights.iter().enumerate() {
-        let limit = nearest_light.map_or(f32::INFINITY, |(_, t)| t);
+        let limit = nearest.map_or(f32::INFINITY, |(_, t)| t);
         if let Some(t) = light.intersect(origin, dir, tmin, limit) {
-            nearest_light = Some((i, t));
+            nearest = Some((i, t));
         }
     }
+    nearest
+}
+
+/// The light a ray sees, if any: the nearest light it hits, unless geometry is nearer. Only
+/// an occlusion query is needed, and none at all for a ray that misses every light, which
+/// is most reflected rays.
+pub fn visible_light(
+    scene: &Scene,
+    lights: &[AreaLight],
+    origin: Vec3,
+    dir: Vec3,
+    tmin: f32,
+) -> Option<usize> {
+    let (i, t) = nearest_light(lights, origin, dir, tmin)?;
+    (!scene
+        .tracer
+        .occluded(origin, dir, tmin, t * (1.0 - LIGHT_TIE_MARGIN)))
+    .then_some(i)
+}
+
+/// Traces a ray against the scene's triangles and the area lights `lights`.
+pub fn trace(scene: &Scene, lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin: f32) -> SceneHit {
+    let nearest_light = nearest_light(lights, origin, dir, tmin);
     let tmax = nearest_light.map_or(f32::INFINITY, |(_, t)| t * (1.0 - LIGHT_TIE_MARGIN));
     match scene.tracer.closest_hit(origin, dir, tmin, tmax) {
         Some(hit) => SceneHit::Surface(hit),
@@ -271,7 +294,7 @@ fn pixel_sample(
             continue;
         }
         traced += 1;
-        if let SceneHit::Light(i) = trace(scene, lights, start, sample.wi, 0.0) {
+        if let Some(i) = visible_light(scene, lights, start, sample.wi, 0.0) {
             let l = lights[i].radiance;
             for c in 0..3 {
                 sum[c] += l[c] * sample.weight;
