@@ -19,5 +19,6 @@ pub mod optics;
 pub mod output_file;
 pub mod photo_in;
 pub mod random;
+pub mod streaks;
 
 pub use error::{Error, Result};
