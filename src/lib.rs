@@ -18,7 +18,14 @@ pub mod error;
 pub mod optics;
 pub mod output_file;
 pub mod photo_in;
+pub mod photo_out;
 pub mod random;
+pub mod render;
+pub mod samples;
+pub mod scene_in;
+pub mod scene_out;
 pub mod streaks;
+pub mod tracing;
+pub mod water_mask;
 
 pub use error::{Error, Result};

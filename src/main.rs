@@ -15,11 +15,17 @@ mod cli;
 enum Command {
     /// Find the streaks (reflections of lights) in a photo and draw pictures of every stage.
     Segment(cli::segment::Args),
+    /// Render the water and the EXT_lights_area lights of a scene as its camera sees them.
+    Render(cli::render::Args),
+    /// Write the sample scenes of the paper's setup and render their photos.
+    Samples(cli::samples::Args),
 }
 
 fn main() -> ExitCode {
     let result = match Command::parse() {
         Command::Segment(args) => cli::segment::run(args),
+        Command::Render(args) => cli::render::run(args),
+        Command::Samples(args) => cli::samples::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

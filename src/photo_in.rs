@@ -71,7 +71,10 @@ impl Photo {
             .iter()
             .map(|p| p.map(|c| srgb_to_linear(c) / exposure))
             .collect();
-        let clipped = display.iter().map(|p| p.iter().any(|&c| c >= 1.0)).collect();
+        let clipped = display
+            .iter()
+            .map(|p| p.iter().any(|&c| c >= 1.0))
+            .collect();
         Photo {
             width,
             height,
@@ -158,7 +161,10 @@ pub fn from_image(image: DynamicImage, exposure: f32) -> std::result::Result<Pho
         }
         _ => {
             let rgb = image.into_rgb8();
-            let display = rgb.pixels().map(|p| p.0.map(|c| c as f32 / 255.0)).collect();
+            let display = rgb
+                .pixels()
+                .map(|p| p.0.map(|c| c as f32 / 255.0))
+                .collect();
             Ok(Photo::from_display(width, height, display, exposure))
         }
     }

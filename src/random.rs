@@ -71,18 +71,24 @@ mod tests {
 
     #[test]
     fn streams_differ_and_repeat() {
-        let a: Vec<u32> = (0..8).map({
-            let mut r = Rng::new(1, 0);
-            move |_| r.next_u32()
-        }).collect();
-        let b: Vec<u32> = (0..8).map({
-            let mut r = Rng::new(1, 0);
-            move |_| r.next_u32()
-        }).collect();
-        let c: Vec<u32> = (0..8).map({
-            let mut r = Rng::new(1, 1);
-            move |_| r.next_u32()
-        }).collect();
+        let a: Vec<u32> = (0..8)
+            .map({
+                let mut r = Rng::new(1, 0);
+                move |_| r.next_u32()
+            })
+            .collect();
+        let b: Vec<u32> = (0..8)
+            .map({
+                let mut r = Rng::new(1, 0);
+                move |_| r.next_u32()
+            })
+            .collect();
+        let c: Vec<u32> = (0..8)
+            .map({
+                let mut r = Rng::new(1, 1);
+                move |_| r.next_u32()
+            })
+            .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
     }

@@ -1,3 +1,5 @@
 //! One file per subcommand: its arguments and a `run` that calls the library.
 
+pub mod render;
+pub mod samples;
 pub mod segment;

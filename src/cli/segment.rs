@@ -16,5 +16,7 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(_args: Args) -> streaklight::Result<()> {
-    Err(streaklight::Error::Usage("segment is not written yet".into()))
+    Err(streaklight::Error::Usage(
+        "segment is not written yet".into(),
+    ))
 }

@@ -1,0 +1,105 @@
+//! `streaklight render SCENE -o PHOTO`.
+
+use std::path::PathBuf;
+
+use streaklight::optics::Shadowing;
+use streaklight::render::{render, RenderOptions};
+use streaklight::scene_in::{self, LoadOptions};
+use streaklight::{output_file, photo_out};
+
+/// Arguments of `streaklight render`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The glTF scene (.gltf or .glb) with a camera, the water and EXT_lights_area lights.
+    pub scene: PathBuf,
+    /// The image to write: .png (8-bit sRGB, clipped) or .exr (linear float).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 600)]
+    pub width: u32,
+    /// Image height in pixels; by default the width divided by the camera's aspect ratio.
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Camera rays per pixel.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Multiplies radiance before it is stored.
+    #[arg(long, default_value_t = 1.0)]
+    pub exposure: f32,
+    /// Seed of every random number: the same seed gives the same image.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Camera node or camera name (default: the first camera of the default scene).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Water node or mesh name (default: the one node whose name contains "water").
+    #[arg(long)]
+    pub water: Option<String>,
+    /// Blinn-Phong gloss e of the water, overriding its material's roughness.
+    #[arg(long)]
+    pub gloss: Option<f32>,
+    /// Index of refraction of the water (default: its material's KHR_materials_ior, else 1.33).
+    #[arg(long)]
+    pub ior: Option<f32>,
+    /// Light intensity units per unit of radiance (METHOD §7).
+    #[arg(long, default_value_t = 1.0)]
+    pub nits_scale: f64,
+    /// Use Smith shadowing in the reflection model.
+    #[arg(long)]
+    pub smith: bool,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> streaklight::Result<()> {
+    photo_out::ImageFormat::from_path(&args.output)?;
+    output_file::ensure_not_an_input(&args.output, &[&args.scene])?;
+    let scene = scene_in::load(
+        &args.scene,
+        &LoadOptions {
+            camera: args.camera,
+            water: args.water,
+            gloss: args.gloss,
+            ior: args.ior,
+            nits_scale: args.nits_scale,
+        },
+    )?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    if scene.area_lights.is_empty() {
+        eprintln!(
+            "warning: {} has no EXT_lights_area lights: the image will be black",
+            args.scene.display()
+        );
+    }
+    let height = args.height.unwrap_or_else(|| {
+        let aspect = scene.camera.aspect_ratio.unwrap_or(1.0);
+        ((args.width as f32 / aspect).round() as u32).max(1)
+    });
+    let options = RenderOptions {
+        width: args.width,
+        height,
+        samples_per_pixel: args.spp,
+        exposure: args.exposure,
+        seed: args.seed,
+        shadowing: if args.smith {
+            Shadowing::Smith
+        } else {
+            Shadowing::None
+        },
+        progress: true,
+    };
+    let image = render(&scene, &options)?;
+    photo_out::write(&args.output, image.width, image.height, &image.pixels)?;
+    eprintln!(
+        "wrote {} ({} x {}, {} spp) in {:.2} s: {:.2} M reflected rays/s",
+        args.output.display(),
+        image.width,
+        image.height,
+        args.spp,
+        image.seconds,
+        image.reflected_rays as f64 / image.seconds.max(1e-9) / 1e6
+    );
+    Ok(())
+}

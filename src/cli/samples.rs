@@ -1,0 +1,32 @@
+//! `streaklight samples [DIR]`: regenerate the sample scenes and photos.
+
+use std::path::PathBuf;
+
+use streaklight::samples;
+
+/// Arguments of `streaklight samples`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Folder to write into.
+    #[arg(default_value = "samples")]
+    pub dir: PathBuf,
+    /// Write the scenes (and the generated water mesh) only; do not render the photos.
+    #[arg(long)]
+    pub scenes_only: bool,
+    /// Camera rays per pixel of the photos.
+    #[arg(long, default_value_t = samples::PHOTO_SPP)]
+    pub spp: u32,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> streaklight::Result<()> {
+    for path in samples::write_scenes(&args.dir)? {
+        eprintln!("wrote {}", path.display());
+    }
+    if !args.scenes_only {
+        for path in samples::render_photos(&args.dir, args.spp, true)? {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}

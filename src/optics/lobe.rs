@@ -1,0 +1,172 @@
+//! The reflection lobe: the model's parameters, importance sampling of `wi`, and evaluation of
+//! the BRDF and of the sampling density.
+
+use glam::{DVec3, Vec2, Vec3};
+
+use super::frame::orthonormal_basis;
+use super::fresnel::fresnel_dielectric;
+use super::microfacet::{blinn_phong_d, cone_cos_theta, CONE_LOST_MASS};
+use super::shadowing::Shadowing;
+
+/// The reflection model of the water surface (METHOD.md §4): Blinn-Phong microfacets of gloss
+/// `e`, a dielectric of index `ior` seen from air, and a choice of geometry term.
+///
+/// Fields are public for convenience; `gloss` must be finite and >= 0 and `ior` > 0 (the
+/// command line checks its inputs before building a model).
+#[derive(Clone, Copy, Debug)]
+pub struct ReflectionModel {
+    /// The Blinn-Phong exponent `e` of the paper (光泽常数).
+    pub gloss: f32,
+    /// Index of refraction of the water (1.33 unless the scene says otherwise).
+    pub ior: f32,
+    /// Which geometry term `G` to use.
+    pub shadowing: Shadowing,
+}
+
+/// One importance sample of the lobe.
+#[derive(Clone, Copy, Debug)]
+pub struct LobeSample {
+    /// Unit direction towards the light, above the surface (`n.wi > 0`).
+    pub wi: Vec3,
+    /// `f(wo, wi) (n.wi) / pdf(wi)`: Fresnel, geometry term and the cone factor
+    /// `1 - CONE_LOST_MASS` included, so the mean of `weight * L(wi)` estimates the reflected
+    /// radiance.
+    pub weight: f32,
+}
+
+const KEEP: f32 = (1.0 - CONE_LOST_MASS) as f32;
+
+impl ReflectionModel {
+    /// A model with the paper's geometry term ([`Shadowing::None`]).
+    pub fn new(gloss: f32, ior: f32) -> Self {
+        ReflectionModel {
+            gloss,
+            ior,
+            shadowing: Shadowing::None,
+        }
+    }
+
+    /// The same model with another geometry term.
+    pub fn with_shadowing(self, shadowing: Shadowing) -> Self {
+        ReflectionModel { shadowing, ..self }
+    }
+
+    /// `cos theta_0`: every sampled half vector satisfies `n.h >= cos theta_0`, and the cone
+    /// holds all but `CONE_LOST_MASS` of the lobe (see the [module docs](super)).
+    pub fn cone_cos_theta(&self) -> f32 {
+        cone_cos_theta(self.gloss as f64) as f32
+    }
+
+    /// Draws `wi` for the view direction `wo` at a point of normal `n` from two uniform numbers
+    /// `u` in [0, 1)^2.
+    ///
+    /// The half vector has `cos theta_h = xi^(1/(e+2))` with `xi = CONE_LOST_MASS +
+    /// (1 - CONE_LOST_MASS) u.x` (so it stays in the cone) and azimuth `2 pi u.y`; `wi` is `wo`
+    /// mirrored about it. Returns `None` when there is nothing to reflect: `wo` below the
+    /// surface (`n.wo <= 0`, possible with interpolated normals), `wo.h <= 0`, or `wi` below
+    /// the surface (`n.wi <= 0`). Those samples count as zero in every estimate.
+    #[inline]
+    pub fn sample(&self, n: Vec3, wo: Vec3, u: Vec2) -> Option<LobeSample> {
+        let cos_o = n.dot(wo);
+        if cos_o <= 0.0 {
+            return None;
+        }
+        let xi = CONE_LOST_MASS as f32 + KEEP * u.x;
+        let log_cos_h = xi.ln() / (self.gloss + 2.0);
+        let cos_h = log_cos_h.exp();
+        // 1 - cos^2 computed as -expm1(2 ln cos): for e in the thousands cos_h is within 1e-4
+        // of one and the direct difference would keep only a few significant digits.
+        let sin_h = (-(2.0 * log_cos_h).exp_m1()).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (std::f32::consts::TAU * u.y).sin_cos();
+        let (t, b) = orthonormal_basis(n);
+        let h = t * (sin_h * cos_phi) + b * (sin_h * sin_phi) + n * cos_h;
+        let cos_oh = wo.dot(h);
+        if cos_oh <= 0.0 {
+            return None;
+        }
+        let wi = h * (2.0 * cos_oh) - wo;
+        let cos_i = n.dot(wi);
+        if cos_i <= 0.0 {
+            return None;
+        }
+        let fresnel = fresnel_dielectric(cos_oh, self.ior);
+        let g = self
+            .shadowing
+            .g(self.gloss, cos_o, cos_i, cos_h, cos_oh, fresnel);
+        // f (n.wi) / pdf(wi) with pdf(wi) = D (n.h) / (4 (wo.h) KEEP): D cancels.
+        let weight = KEEP * fresnel * g * cos_oh / (cos_o * cos_h);
+        Some(LobeSample { wi, weight })
+    }
+
+    /// `f(wo, wi) (n.wi)`: the BRDF times the cosine at the light, 0 when either direction is
+    /// below the surface or the half vector is outside the cone. Computed in f64 so the power
+    /// in `D` keeps its precision at high gloss.
+    pub fn eval_cos(&self, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
+        match self.half_vector(n, wo, wi) {
+            Some(hv) => {
+                let d = blinn_phong_d(hv.cos_h, self.gloss as f64);
+                let fresnel = fresnel_dielectric(hv.cos_oh as f32, self.ior);
+                let g = self.shadowing.g(
+                    self.gloss,
+                    hv.cos_o as f32,
+                    hv.cos_i as f32,
+                    hv.cos_h as f32,
+                    hv.cos_oh as f32,
+                    fresnel,
+                );
+                (d * fresnel as f64 * g as f64 / (4.0 * hv.cos_o)) as f32
+            }
+            None => 0.0,
+        }
+    }
+
+    /// The solid-angle density with which [`sample`](Self::sample) returns `wi` (for multiple
+    /// importance sampling): `D(h) (n.h) / (4 (wo.h) (1 - CONE_LOST_MASS))` inside the cone, 0
+    /// where `sample` never returns `wi`. Samples lost below the surface make it integrate to
+    /// slightly less than 1.
+    pub fn pdf(&self, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
+        match self.half_vector(n, wo, wi) {
+            Some(hv) => {
+                let d = blinn_phong_d(hv.cos_h, self.gloss as f64);
+                (d * hv.cos_h / (4.0 * hv.cos_oh * (1.0 - CONE_LOST_MASS))) as f32
+            }
+            None => 0.0,
+        }
+    }
+
+    /// The cosines of a pair of directions that the lobe reaches, or `None`.
+    fn half_vector(&self, n: Vec3, wo: Vec3, wi: Vec3) -> Option<HalfVector> {
+        // Renormalised in f64: an f32 unit vector is off by up to ~1e-7 in length, and
+        // wo.h - wi.h = (|wo|^2 - |wi|^2) / |wo + wi|, which for a facet seen at grazing
+        // (wo.h ~ 1e-3) turns that into percent-level asymmetry and error.
+        let (n, wo, wi) = (
+            n.as_dvec3().normalize(),
+            wo.as_dvec3().normalize(),
+            wi.as_dvec3().normalize(),
+        );
+        let cos_o = n.dot(wo);
+        let cos_i = n.dot(wi);
+        if cos_o <= 0.0 || cos_i <= 0.0 {
+            return None;
+        }
+        // Both directions are above the surface, so wo + wi is not zero and wo.h > 0.
+        let h: DVec3 = (wo + wi).normalize();
+        let cos_h = n.dot(h);
+        if cos_h < cone_cos_theta(self.gloss as f64) {
+            return None;
+        }
+        Some(HalfVector {
+            cos_o,
+            cos_i,
+            cos_h,
+            cos_oh: wo.dot(h),
+        })
+    }
+}
+
+struct HalfVector {
+    cos_o: f64,
+    cos_i: f64,
+    cos_h: f64,
+    cos_oh: f64,
+}

@@ -1,0 +1,297 @@
+//! Rendering the water under a scene's area lights: the forward model the fit inverts, used
+//! to make sample photos and to check a fit by re-rendering it.
+//!
+//! Per pixel, jittered camera rays integrate over the pixel's footprint (METHOD §2). A camera
+//! ray that hits a light sees its radiance; one that hits the water samples the reflection
+//! lobe once and sees what the reflected ray's closest hit is; everything else is black
+//! (night). Each pixel draws its random numbers from its own stream, so the image does not
+//! depend on how many threads render it.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use crate::optics::{ReflectionModel, Shadowing};
+use crate::random::Rng;
+use crate::scene_in::{AreaLight, Scene};
+use crate::{Error, Result};
+
+/// How to render.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel: lobe samples on the water, split over jittered camera rays
+    /// (see [`camera_rays_per_pixel`]).
+    pub samples_per_pixel: u32,
+    /// Multiplies radiance before it is stored (the photo's exposure).
+    pub exposure: f32,
+    /// Seed of every random number.
+    pub seed: u64,
+    /// Shadowing term of the reflection model.
+    pub shadowing: Shadowing,
+    /// Show a progress bar on stderr (only drawn when stderr is a terminal).
+    pub progress: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 600,
+            height: 600,
+            samples_per_pixel: 64,
+            exposure: 1.0,
+            seed: 1,
+            shadowing: Shadowing::None,
+            progress: false,
+        }
+    }
+}
+
+/// A rendered image and what it cost.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear RGB per pixel, radiance times exposure, row 0 at the top.
+    pub pixels: Vec<[f32; 3]>,
+    /// Camera rays traced.
+    pub camera_rays: u64,
+    /// Reflected rays traced from the water.
+    pub reflected_rays: u64,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// What a ray sees first.
+pub enum SceneHit {
+    /// The emitting face of area light `index`.
+    Light(usize),
+    /// A triangle of the scene.
+    Surface(crate::tracing::Hit),
+    /// Nothing.
+    Miss,
+}
+
+/// How much nearer geometry must be than a light to hide it. Lights usually sit on a wall,
+/// coplanar with it; without a margin the wall would hide them by rounding.
+const LIGHT_TIE_MARGIN: f32 = 1e-4;
+
+/// Traces a ray against the scene's triangles and the area lights `lights`.
+pub fn trace(scene: &Scene, lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin: f32) -> SceneHit {
+    let mut nearest_light: Option<(usize, f32)> = None;
+    for (i, light) in lights.iter().enumerate() {
+        let limit = nearest_light.map_or(f32::INFINITY, |(_, t)| t);
+        if let Some(t) = light.intersect(origin, dir, tmin, limit) {
+            nearest_light = Some((i, t));
+        }
+    }
+    let tmax = nearest_light.map_or(f32::INFINITY, |(_, t)| t * (1.0 - LIGHT_TIE_MARGIN));
+    match scene.tracer.closest_hit(origin, dir, tmin, tmax) {
+        Some(hit) => SceneHit::Surface(hit),
+        None => match nearest_light {
+            Some((i, _)) => SceneHit::Light(i),
+            None => SceneHit::Miss,
+        },
+    }
+}
+
+/// Offset that lifts a reflected ray's origin off the surface, relative to the hit's
+/// distance from the scene origin (f32 rounding grows with it).
+pub fn surface_offset(p: Vec3) -> f32 {
+    1e-5 * (1.0 + p.abs().max_element())
+}
+
+/// Renders the scene's water and lights as the camera sees them.
+pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
+    render_with_lights(scene, &scene.area_lights, options)
+}
+
+/// Renders the scene's water under `lights` instead of the scene's own (to check a fit).
+pub fn render_with_lights(
+    scene: &Scene,
+    lights: &[AreaLight],
+    options: &RenderOptions,
+) -> Result<Rendered> {
+    let (w, h) = (options.width, options.height);
+    if w == 0 || h == 0 || w > 32768 || h > 32768 {
+        return Err(Error::Usage(format!(
+            "the image size {w} x {h} is out of range (1 to 32768 on each side)"
+        )));
+    }
+    if options.samples_per_pixel == 0 {
+        return Err(Error::Usage("--spp must be at least 1".into()));
+    }
+    if !(options.exposure.is_finite() && options.exposure > 0.0) {
+        return Err(Error::Usage(format!(
+            "--exposure must be a positive number, not {}",
+            options.exposure
+        )));
+    }
+    let model = ReflectionModel {
+        gloss: scene.water.gloss,
+        ior: scene.water.ior,
+        shadowing: options.shadowing,
+    };
+    let start = Instant::now();
+    let reflected = AtomicU64::new(0);
+    let bar = progress_bar(options.progress, h as u64);
+    let mut pixels = vec![[0f32; 3]; w as usize * h as usize];
+    pixels
+        .par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let mut row_reflected = 0u64;
+            for (x, out) in row.iter_mut().enumerate() {
+                let index = y as u64 * w as u64 + x as u64;
+                let mut rng = Rng::new(options.seed, index);
+                let mut sum = [0f64; 3];
+                let camera_rays = camera_rays_per_pixel(options.samples_per_pixel);
+                let lobe_samples = options.samples_per_pixel / camera_rays;
+                let strata = (camera_rays as f32).sqrt() as u32;
+                for k in 0..camera_rays {
+                    let (value, traced) = pixel_sample(
+                        scene,
+                        lights,
+                        &model,
+                        PixelSample {
+                            x: x as u32,
+                            y: y as u32,
+                            stratum: k,
+                            strata,
+                            lobe_samples,
+                        },
+                        w,
+                        h,
+                        &mut rng,
+                    );
+                    row_reflected += traced as u64;
+                    for c in 0..3 {
+                        sum[c] += value[c] as f64;
+                    }
+                }
+                let scale = options.exposure as f64 / camera_rays as f64;
+                *out = sum.map(|s| (s * scale) as f32);
+            }
+            reflected.fetch_add(row_reflected, Ordering::Relaxed);
+            bar.inc(1);
+        });
+    bar.finish_and_clear();
+    Ok(Rendered {
+        width: w,
+        height: h,
+        pixels,
+        camera_rays: w as u64 * h as u64 * camera_rays_per_pixel(options.samples_per_pixel) as u64,
+        reflected_rays: reflected.into_inner(),
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Lobe samples traced from each camera ray's water hit. Tracing the camera ray is as costly
+/// as tracing a reflected one, and the pixel's value varies far more over the reflection lobe
+/// than over the pixel's footprint, so each camera ray is shared by a few lobe samples.
+pub const LOBE_SAMPLES_PER_CAMERA_RAY: u32 = 4;
+
+/// Camera rays per pixel for `samples_per_pixel` samples: the samples are split into camera
+/// rays of [`LOBE_SAMPLES_PER_CAMERA_RAY`] lobe samples each (one lobe sample each when there
+/// are too few samples to split).
+pub fn camera_rays_per_pixel(samples_per_pixel: u32) -> u32 {
+    if samples_per_pixel >= LOBE_SAMPLES_PER_CAMERA_RAY * 4 {
+        samples_per_pixel / LOBE_SAMPLES_PER_CAMERA_RAY
+    } else {
+        samples_per_pixel
+    }
+}
+
+/// Which camera ray of a pixel to trace.
+struct PixelSample {
+    x: u32,
+    y: u32,
+    /// Index of the camera ray within the pixel.
+    stratum: u32,
+    /// The pixel is split into strata x strata cells for the first strata^2 camera rays, so
+    /// that the footprint is covered evenly (the rest are uniformly jittered).
+    strata: u32,
+    /// Lobe samples to average at the water hit.
+    lobe_samples: u32,
+}
+
+/// One camera ray of a pixel: the mean radiance its lobe samples carry, and how many
+/// reflected rays were traced.
+fn pixel_sample(
+    scene: &Scene,
+    lights: &[AreaLight],
+    model: &ReflectionModel,
+    s: PixelSample,
+    w: u32,
+    h: u32,
+    rng: &mut Rng,
+) -> ([f32; 3], u32) {
+    let (mut fx, mut fy) = (rng.next_f32(), rng.next_f32());
+    if s.stratum < s.strata * s.strata {
+        let n = s.strata as f32;
+        fx = ((s.stratum % s.strata) as f32 + fx) / n;
+        fy = ((s.stratum / s.strata) as f32 + fy) / n;
+    }
+    let origin = scene.camera.position;
+    let dir = scene
+        .camera
+        .direction(s.x as f32 + fx, s.y as f32 + fy, w, h);
+    let hit = match trace(scene, lights, origin, dir, 0.0) {
+        SceneHit::Light(i) => return (lights[i].radiance, 0),
+        SceneHit::Miss => return ([0.0; 3], 0),
+        SceneHit::Surface(hit) => hit,
+    };
+    if !scene.is_water[hit.triangle as usize] {
+        return ([0.0; 3], 0);
+    }
+    let p = origin + dir * hit.t;
+    let wo = -dir;
+    let n = scene.shading_normal(hit.triangle, hit.barycentric);
+    let mut face = scene.face_normal(hit.triangle);
+    if face.dot(wo) < 0.0 {
+        face = -face;
+    }
+    let start = p + face * surface_offset(p);
+    let mut sum = [0f32; 3];
+    let mut traced = 0;
+    for _ in 0..s.lobe_samples {
+        let u = Vec2::new(rng.next_f32(), rng.next_f32());
+        let Some(sample) = model.sample(n, wo, u) else {
+            continue;
+        };
+        // A reflected ray that would enter the water geometrically sees nothing.
+        if face.dot(sample.wi) <= 0.0 {
+            continue;
+        }
+        traced += 1;
+        if let SceneHit::Light(i) = trace(scene, lights, start, sample.wi, 0.0) {
+            let l = lights[i].radiance;
+            for c in 0..3 {
+                sum[c] += l[c] * sample.weight;
+            }
+        }
+    }
+    let inv = 1.0 / s.lobe_samples as f32;
+    (sum.map(|c| c * inv), traced)
+}
+
+fn progress_bar(enabled: bool, rows: u64) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !enabled || !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(rows);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "rendering {bar:40} {pos}/{len} rows, {elapsed} elapsed, ~{eta} left",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}

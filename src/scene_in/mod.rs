@@ -1,0 +1,271 @@
+//! Step 1 of METHOD.md §5: load the scene.
+//!
+//! The node hierarchy is baked to world space in f64, recentred on the camera, and only then
+//! rounded to f32. Every triangle goes into one BVH ([`crate::tracing::Tracer`]).
+
+mod area_lights;
+mod camera;
+pub mod document;
+mod meshes;
+mod nodes;
+mod water;
+
+use std::path::{Path, PathBuf};
+
+use glam::{DVec3, Vec3};
+
+pub use area_lights::AreaLight;
+pub use camera::Camera;
+pub use meshes::{is_fallback_quad, TriangleSource};
+pub use nodes::{world_instances, NodeInstance};
+pub use water::{gloss_from_roughness, roughness_from_gloss, Water, DEFAULT_GLOSS, WATER_IOR};
+
+use crate::tracing::{Tracer, Triangle};
+use crate::{Error, Result};
+
+/// What the user chose on the command line about the scene.
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Camera node or camera name; the first camera of the default scene if `None`.
+    pub camera: Option<String>,
+    /// Water node or mesh name; found by name if `None` (METHOD §3).
+    pub water: Option<String>,
+    /// Gloss e overriding the water material's.
+    pub gloss: Option<f32>,
+    /// IOR overriding the water material's.
+    pub ior: Option<f32>,
+    /// Divides light intensities to get radiance (METHOD §7).
+    pub nits_scale: f64,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            camera: None,
+            water: None,
+            gloss: None,
+            ior: None,
+            nits_scale: 1.0,
+        }
+    }
+}
+
+/// A loaded scene, ready to trace.
+pub struct Scene {
+    /// The scene file.
+    pub path: PathBuf,
+    /// World position of the scene frame's origin (the camera): every position here is
+    /// relative to it.
+    pub origin: DVec3,
+    /// The camera of the photo.
+    pub camera: Camera,
+    /// The water and its optical constants.
+    pub water: Water,
+    /// Triangle corners, in the order the tracer's hits refer to.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Shading normals at the corners of each triangle.
+    pub normals: Vec<[Vec3; 3]>,
+    /// Where each triangle came from.
+    pub sources: Vec<TriangleSource>,
+    /// True for triangles of the water node.
+    pub is_water: Vec<bool>,
+    /// The BVH over `triangles`.
+    pub tracer: Tracer,
+    /// Rect lights found in the scene.
+    pub area_lights: Vec<AreaLight>,
+    /// Degenerate or non-finite triangles left out.
+    pub dropped_triangles: usize,
+    /// Things the user should know (skipped primitives, defaults used).
+    pub warnings: Vec<String>,
+    /// Node names by index (`None` where unnamed), for messages and reports.
+    pub node_names: Vec<Option<String>>,
+}
+
+fn check_override(value: Option<f32>, what: &str, min_exclusive: f32) -> Result<()> {
+    if let Some(v) = value {
+        if !(v.is_finite() && v > min_exclusive) {
+            return Err(Error::Usage(format!(
+                "{what} must be a number greater than {min_exclusive}, not {v}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Loads the scene at `path` (`.gltf` or `.glb`).
+pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
+    check_override(options.gloss, "--gloss", 0.0)?;
+    check_override(options.ior, "--ior", 1.0)?;
+    if !(options.nits_scale.is_finite() && options.nits_scale > 0.0) {
+        return Err(Error::Usage(format!(
+            "--nits-scale must be a positive number, not {}",
+            options.nits_scale
+        )));
+    }
+    let source = document::read(path)?;
+    let doc = &source.document;
+    let err = |m: String| Error::scene(path, m);
+    let instances = nodes::world_instances(doc, &source.json).map_err(err)?;
+
+    let camera = choose_camera(doc, &instances, options.camera.as_deref()).map_err(err)?;
+    let (cam_node, cam_world, yfov, aspect) = camera;
+    let origin = cam_world.w_axis.truncate();
+    if !origin.is_finite() {
+        return Err(Error::scene(path, "the camera's position is not finite"));
+    }
+    let node_names: Vec<Option<String>> =
+        doc.nodes().map(|n| n.name().map(str::to_owned)).collect();
+    let cam_name = node_names[cam_node]
+        .clone()
+        .or_else(|| {
+            doc.nodes()
+                .nth(cam_node)
+                .and_then(|n| n.camera())
+                .and_then(|c| c.name().map(str::to_owned))
+        })
+        .unwrap_or_else(|| format!("node {cam_node}"));
+    let camera = Camera::from_world(cam_name, cam_node, &cam_world, origin, yfov, aspect)
+        .ok_or_else(|| Error::scene(path, "the camera's node matrix is degenerate"))?;
+    if !(yfov.is_finite() && yfov > 0.0 && yfov < std::f32::consts::PI) {
+        return Err(Error::scene(
+            path,
+            format!("the camera's yfov {yfov} is not between 0 and pi"),
+        ));
+    }
+
+    let mut warnings = Vec::new();
+    let water_node =
+        water::choose(doc, &source.json, &instances, options.water.as_deref()).map_err(err)?;
+    let water = water::optics(doc, water_node, options.gloss, options.ior, &mut warnings);
+
+    let tris =
+        meshes::collect(doc, &source.json, &source.buffers, &instances, origin).map_err(err)?;
+    warnings.extend(tris.warnings.iter().cloned());
+    if tris.dropped > 0 {
+        warnings.push(format!(
+            "{} degenerate or non-finite triangles were left out",
+            tris.dropped
+        ));
+    }
+    let is_water: Vec<bool> = tris
+        .sources
+        .iter()
+        .map(|s| s.node as usize == water_node)
+        .collect();
+    if !is_water.iter().any(|&w| w) {
+        return Err(Error::scene(
+            path,
+            format!("the water node \"{}\" has no usable triangles", water.name),
+        ));
+    }
+    let area_lights = area_lights::read(
+        &source.json,
+        &instances,
+        origin,
+        options.nits_scale,
+        &mut warnings,
+    );
+    let tracer = Tracer::new(
+        &tris
+            .positions
+            .iter()
+            .map(|&vertices| Triangle { vertices })
+            .collect::<Vec<_>>(),
+    );
+    Ok(Scene {
+        path: path.to_path_buf(),
+        origin,
+        camera,
+        water,
+        triangles: tris.positions,
+        normals: tris.normals,
+        sources: tris.sources,
+        is_water,
+        tracer,
+        area_lights,
+        dropped_triangles: tris.dropped,
+        warnings,
+        node_names,
+    })
+}
+
+type CameraChoice = (usize, glam::DMat4, f32, Option<f32>);
+
+fn choose_camera(
+    doc: &gltf::Document,
+    instances: &[NodeInstance],
+    requested: Option<&str>,
+) -> std::result::Result<CameraChoice, String> {
+    let with_camera: Vec<(&NodeInstance, gltf::Camera)> = instances
+        .iter()
+        .filter_map(|i| {
+            doc.nodes()
+                .nth(i.node)
+                .and_then(|n| n.camera())
+                .map(|c| (i, c))
+        })
+        .collect();
+    let label = |i: &NodeInstance, c: &gltf::Camera| {
+        doc.nodes()
+            .nth(i.node)
+            .and_then(|n| n.name().map(str::to_owned))
+            .or_else(|| c.name().map(str::to_owned))
+            .unwrap_or_else(|| format!("node {}", i.node))
+    };
+    let chosen = match requested {
+        Some(want) => with_camera
+            .iter()
+            .find(|(i, c)| {
+                doc.nodes().nth(i.node).and_then(|n| n.name()) == Some(want)
+                    || c.name() == Some(want)
+            })
+            .ok_or_else(|| {
+                let names: Vec<String> = with_camera.iter().map(|(i, c)| label(i, c)).collect();
+                if names.is_empty() {
+                    format!("no camera named \"{want}\": the scene has no camera")
+                } else {
+                    format!(
+                        "no camera named \"{want}\"; the cameras are: {}",
+                        names.join(", ")
+                    )
+                }
+            })?,
+        None => with_camera.first().ok_or_else(|| {
+            "the scene has no camera: add a perspective camera that sees the water as the photo was taken"
+                .to_owned()
+        })?,
+    };
+    let (instance, cam) = chosen;
+    match cam.projection() {
+        gltf::camera::Projection::Perspective(p) => {
+            Ok((instance.node, instance.world, p.yfov(), p.aspect_ratio()))
+        }
+        gltf::camera::Projection::Orthographic(_) => Err(format!(
+            "the camera \"{}\" is orthographic; a photo needs a perspective camera",
+            label(instance, cam)
+        )),
+    }
+}
+
+impl Scene {
+    /// The unit shading normal at a hit on `triangle` with barycentric weights `b`.
+    pub fn shading_normal(&self, triangle: u32, b: [f32; 3]) -> Vec3 {
+        let n = self.normals[triangle as usize];
+        (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).normalize_or_zero()
+    }
+
+    /// The unit geometric normal of `triangle` (by its winding).
+    pub fn face_normal(&self, triangle: u32) -> Vec3 {
+        let [a, b, c] = self.triangles[triangle as usize];
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
+    /// The name of node `index` for messages.
+    pub fn node_label(&self, index: usize) -> String {
+        self.node_names
+            .get(index)
+            .cloned()
+            .flatten()
+            .unwrap_or_else(|| format!("node {index}"))
+    }
+}
