@@ -86,11 +86,10 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         }
     }
     let water = water_mask::water_mask(&scene, photo.width, photo.height);
-    let seg = streaks::extract_streaks(&photo, &water, &params)
-        .map_err(|e| match e {
-            Error::NothingFound(m) => Error::NothingFound(format!("{}: {m}", args.photo.display())),
-            other => other,
-        })?;
+    let seg = streaks::extract_streaks(&photo, &water, &params).map_err(|e| match e {
+        Error::NothingFound(m) => Error::NothingFound(format!("{}: {m}", args.photo.display())),
+        other => other,
+    })?;
 
     std::fs::create_dir_all(&args.out_dir).map_err(|e| Error::io(&args.out_dir, e))?;
     let written = pictures::write_pictures(&args.out_dir, &photo, &water, &seg)?;
