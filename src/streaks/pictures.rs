@@ -59,8 +59,8 @@ fn cross(img: &mut RgbImage, x: u32, y: u32, c: [u8; 3]) {
 }
 
 fn blend(px: &mut Rgb<u8>, c: [u8; 3], alpha: f32) {
-    for k in 0..3 {
-        px.0[k] = (px.0[k] as f32 * (1.0 - alpha) + c[k] as f32 * alpha).round() as u8;
+    for (v, &target) in px.0.iter_mut().zip(&c) {
+        *v = (*v as f32 * (1.0 - alpha) + target as f32 * alpha).round() as u8;
     }
 }
 

@@ -56,7 +56,7 @@ impl SeedParams {
                 self.blur_sigma
             )));
         }
-        if self.row_filter == 0 || self.row_filter % 2 == 0 {
+        if self.row_filter == 0 || self.row_filter.is_multiple_of(2) {
             return Err(Error::Usage(format!(
                 "the row mean filter width must be odd, not {}",
                 self.row_filter
