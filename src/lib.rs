@@ -25,6 +25,7 @@ pub mod report;
 pub mod samples;
 pub mod scene_in;
 pub mod scene_out;
+pub mod streaks;
 pub mod tracing;
 pub mod water_mask;
 
