@@ -15,6 +15,7 @@
 //! | sample scenes of the paper's setup | [`samples`] |
 
 pub mod error;
+pub mod fitting;
 pub mod optics;
 pub mod output_file;
 pub mod photo_in;

@@ -1,0 +1,316 @@
+//! Steps 7-9 of METHOD §5 (the paper's §4.2-4.3): for each streak, the plane its light hangs
+//! on, the light's radiance, and the rectangle's four edges.
+//!
+//! The forward model is exactly the renderer's ([`crate::render`]): a pixel is the mean over
+//! jittered camera rays across its footprint of one lobe sample each, reflected from the water
+//! with the same normals and offset. Each traced pixel's samples that land on the light's plane
+//! are stored once ([`footprint::Footprint`]); every coefficient `c(p; rect)` afterwards is a
+//! sum over them. Radiance and edges are then alternated until they agree:
+//!
+//! 1. plane: the face most of the brightest pixel's lobe rays hit first ([`light_plane`]);
+//! 2. radiance: least squares over the brightest interior pixels with the current rectangle
+//!    (the whole plane at first, as the paper does) ([`radiance`]);
+//! 3. edges: each streak-edge pixel, assigned to the light edge its lobe's centre lies beyond,
+//!    moves that edge until its modelled coefficient equals `I(p)/L`; the edge is the weighted
+//!    mean of those solutions ([`edges`]).
+//!
+//! Fragments of one light are merged and refitted ([`fragments`]).
+
+pub mod edges;
+pub mod footprint;
+pub mod fragments;
+pub mod light_plane;
+pub mod observation;
+pub mod radiance;
+pub mod rect;
+mod single;
+
+use std::time::Instant;
+
+use glam::DVec3;
+
+pub use light_plane::LightPlane;
+pub use observation::{StreakObservation, StreakSide};
+pub use rect::Rect;
+
+use crate::optics::ReflectionModel;
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+use crate::{Error, Result};
+
+/// How to fit.
+#[derive(Clone, Copy, Debug)]
+pub struct FitOptions {
+    /// Lobe samples per traced pixel (camera-ray jitter and lobe direction drawn together, as
+    /// the renderer does). The edge solutions average over tens of pixels, so a few hundred
+    /// suffice; more lowers the fit's own noise.
+    pub samples: u32,
+    /// Seed of every random number of the fit.
+    pub seed: u64,
+    /// The water's reflection model (gloss and IOR from the scene unless overridden).
+    pub model: ReflectionModel,
+}
+
+impl FitOptions {
+    /// Default options for a scene: its water's gloss and IOR, the paper's geometry term,
+    /// [`DEFAULT_SAMPLES`] samples, seed 1.
+    pub fn for_scene(scene: &Scene) -> Self {
+        FitOptions {
+            samples: DEFAULT_SAMPLES,
+            seed: 1,
+            model: ReflectionModel::new(scene.water.gloss, scene.water.ior),
+        }
+    }
+}
+
+/// Default lobe samples per traced pixel.
+pub const DEFAULT_SAMPLES: u32 = 512;
+
+/// An edge of the light's rectangle (of the light, not of the streak).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EdgeSide {
+    /// Smallest u.
+    Left = 0,
+    /// Largest u.
+    Right = 1,
+    /// Smallest v.
+    Bottom = 2,
+    /// Largest v.
+    Top = 3,
+}
+
+impl EdgeSide {
+    /// All four, in the order of [`FittedLight::edges`].
+    pub const ALL: [EdgeSide; 4] = [
+        EdgeSide::Left,
+        EdgeSide::Right,
+        EdgeSide::Bottom,
+        EdgeSide::Top,
+    ];
+
+    /// "left", "right", "bottom" or "top".
+    pub fn name(self) -> &'static str {
+        match self {
+            EdgeSide::Left => "left",
+            EdgeSide::Right => "right",
+            EdgeSide::Bottom => "bottom",
+            EdgeSide::Top => "top",
+        }
+    }
+}
+
+/// Whether the photo determines an edge.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EdgeStatus {
+    /// Fitted from this many streak-edge pixels.
+    Constrained {
+        /// Pixels whose solutions were combined.
+        pixels: usize,
+    },
+    /// The photo does not show this edge (the streak runs out of the photo or off the water,
+    /// or no edge pixel looks past it). The edge is placed as far out as any traced pixel's
+    /// lobe reaches: the photo cannot tell it apart from any position beyond.
+    Unconstrained {
+        /// Why, for a person.
+        reason: String,
+    },
+}
+
+/// A fitted rectangle light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedLight {
+    /// The streaks (fragments) it explains.
+    pub streak_ids: Vec<usize>,
+    /// The face it lies on and the (u, v) frame of the rectangle.
+    pub plane: LightPlane,
+    /// Left edge, along `plane.u` from `plane.point`.
+    pub u_min: f32,
+    /// Right edge.
+    pub u_max: f32,
+    /// Bottom edge, along `plane.v`.
+    pub v_min: f32,
+    /// Top edge.
+    pub v_max: f32,
+    /// Linear RGB radiance (the photo's units, after exposure), emitted along `plane.normal`.
+    pub radiance: [f32; 3],
+    /// Status of the left, right, bottom and top edges (indexed by [`EdgeSide`]).
+    pub edges: [EdgeStatus; 4],
+}
+
+impl FittedLight {
+    /// The rectangle in plane coordinates.
+    pub fn rect(&self) -> Rect {
+        Rect {
+            u_min: self.u_min,
+            u_max: self.u_max,
+            v_min: self.v_min,
+            v_max: self.v_max,
+        }
+    }
+
+    /// Width along `plane.u`.
+    pub fn width(&self) -> f32 {
+        self.u_max - self.u_min
+    }
+
+    /// Height along `plane.v`.
+    pub fn height(&self) -> f32 {
+        self.v_max - self.v_min
+    }
+
+    /// The point at plane coordinates (u, v), in world coordinates (`origin` is the scene
+    /// frame's origin, [`Scene::origin`]).
+    pub fn world_at(&self, origin: DVec3, u: f32, v: f32) -> DVec3 {
+        origin
+            + self.plane.point.as_dvec3()
+            + self.plane.u.as_dvec3() * u as f64
+            + self.plane.v.as_dvec3() * v as f64
+    }
+
+    /// The rectangle's centre in world coordinates.
+    pub fn center_world(&self, origin: DVec3) -> DVec3 {
+        let c = self.rect().center();
+        self.world_at(origin, c.x, c.y)
+    }
+
+    /// The corner at (u_min, v_min) in world coordinates: the left-bottom corner as seen from
+    /// in front of the light (the paper's tables give this corner).
+    pub fn corner_left_bottom_world(&self, origin: DVec3) -> DVec3 {
+        self.world_at(origin, self.u_min, self.v_min)
+    }
+}
+
+/// A streak that gave no light.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Skipped {
+    /// The reflected rays at the streak's brightest pixel hit no geometry.
+    NoPlane {
+        /// The streak's id.
+        streak: usize,
+        /// What to do about it.
+        message: String,
+    },
+    /// A plane was found but no rectangle could be fitted (no usable pixel).
+    NoSolution {
+        /// The streak's id.
+        streak: usize,
+        /// Why.
+        message: String,
+    },
+}
+
+/// The fit of a photo.
+#[derive(Clone, Debug)]
+pub struct FitOutcome {
+    /// One light per streak, fragments of one light merged; in the order of their first
+    /// streak.
+    pub lights: Vec<FittedLight>,
+    /// Streaks that gave no light.
+    pub skipped: Vec<Skipped>,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+    /// Wall-clock seconds per stage: "plane", "footprints", "solve", "fragments".
+    pub timings: Vec<(String, f64)>,
+}
+
+/// Fits one rectangle light per streak (METHOD §5 steps 7-9), merging fragments of one light.
+///
+/// `water` is the water mask of the photo ([`crate::water_mask::water_mask`]); `streaks` come
+/// from the streak extraction. Fails only on inconsistent inputs (sizes that do not match);
+/// a streak that cannot be fitted is reported in [`FitOutcome::skipped`].
+pub fn fit_paper(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    options: &FitOptions,
+) -> Result<FitOutcome> {
+    let n = photo.width as usize * photo.height as usize;
+    if photo.radiance.len() != n || photo.clipped.len() != n || water.len() != n {
+        return Err(Error::Usage(format!(
+            "the photo ({} x {}) and its water mask ({} pixels) do not match",
+            photo.width,
+            photo.height,
+            water.len()
+        )));
+    }
+    if options.samples == 0 {
+        return Err(Error::Usage("the fit needs at least one sample per pixel".into()));
+    }
+    for s in streaks {
+        let bad = s
+            .pixels
+            .iter()
+            .chain(s.edges.iter().flatten())
+            .chain(std::iter::once(&s.brightest))
+            .find(|&&p| p as usize >= n);
+        if let Some(p) = bad {
+            return Err(Error::Usage(format!(
+                "streak {} holds pixel index {p}, outside the {} x {} photo",
+                s.id, photo.width, photo.height
+            )));
+        }
+    }
+    let mut times = single::StageTimes::default();
+    let mut fitted: Vec<(StreakObservation, FittedLight)> = Vec::new();
+    let mut skipped = Vec::new();
+    for obs in streaks {
+        match single::fit_streak(scene, photo, water, obs, options, &mut times) {
+            Ok(light) => fitted.push((obs.clone(), light)),
+            Err(s) => skipped.push(s),
+        }
+    }
+    let t = Instant::now();
+    let mut warnings = Vec::new();
+    let mut fragment_fit = single::StageTimes::default();
+    loop {
+        let lights: Vec<FittedLight> = fitted.iter().map(|f| f.1.clone()).collect();
+        let Some((i, j)) = fragments::overlapping_pair(&lights) else {
+            break;
+        };
+        let (obs_j, light_j) = fitted.remove(j);
+        let (obs_i, light_i) = fitted.remove(i);
+        let mut ids: Vec<usize> = light_i.streak_ids.iter().chain(&light_j.streak_ids).copied().collect();
+        ids.sort_unstable();
+        let merged = fragments::merge(&obs_i, &obs_j, photo);
+        match merged.map(|m| {
+            let fit = single::fit_streak(scene, photo, water, &m, options, &mut fragment_fit);
+            (m, fit)
+        }) {
+            Some((m, Ok(mut light))) => {
+                light.streak_ids = ids;
+                fitted.insert(i, (m, light));
+            }
+            _ => {
+                warnings.push(format!(
+                    "streaks {ids:?} overlap on one face but their union could not be fitted; \
+                     kept the fit of streak {}",
+                    obs_i.id
+                ));
+                fitted.insert(i, (obs_i, light_i));
+            }
+        }
+    }
+    for (_, light) in &fitted {
+        if light.plane.hit_fraction < 0.5 {
+            warnings.push(format!(
+                "streak {:?}: only {:.0} % of the brightest pixel's reflected rays hit the light's \
+                 plane; the plane may be wrong",
+                light.streak_ids,
+                100.0 * light.plane.hit_fraction
+            ));
+        }
+    }
+    let fragments_seconds = t.elapsed().as_secs_f64();
+    Ok(FitOutcome {
+        lights: fitted.into_iter().map(|f| f.1).collect(),
+        skipped,
+        warnings,
+        timings: vec![
+            ("plane".into(), times.plane),
+            ("footprints".into(), times.footprints),
+            ("solve".into(), times.solve),
+            ("fragments".into(), fragments_seconds),
+        ],
+    })
+}

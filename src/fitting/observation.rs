@@ -1,0 +1,115 @@
+//! The fitter's input: one streak (or streak fragment) as pixel sets, and the streak-edge rule
+//! of METHOD §5 step 6.
+
+/// One streak of the photo, as the streak extraction hands it to the fitter.
+///
+/// Pixel indices are `y * width + x` of the photo.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StreakObservation {
+    /// Identifier of the streak (reported back in [`super::FittedLight::streak_ids`]).
+    pub id: usize,
+    /// Every pixel of the streak.
+    pub pixels: Vec<u32>,
+    /// The brightest pixel of the streak's brightest superpixel: where the light plane is
+    /// searched (METHOD §5 step 7).
+    pub brightest: u32,
+    /// Edge pixels of the streak on its left, right, top and bottom sides in the image
+    /// (METHOD §5 step 6), in that order; see [`StreakSide`].
+    pub edges: [Vec<u32>; 4],
+}
+
+/// A side of a streak in the image (not of the light: a reflection flips top and bottom).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StreakSide {
+    /// Towards column 0.
+    Left = 0,
+    /// Towards the last column.
+    Right = 1,
+    /// Towards row 0.
+    Top = 2,
+    /// Towards the last row.
+    Bottom = 3,
+}
+
+impl StreakSide {
+    /// All four, in the order of [`StreakObservation::edges`].
+    pub const ALL: [StreakSide; 4] = [
+        StreakSide::Left,
+        StreakSide::Right,
+        StreakSide::Top,
+        StreakSide::Bottom,
+    ];
+
+    /// The three neighbour offsets (dx, dy) on this side of a pixel in its 3 x 3.
+    pub fn outward_neighbours(self) -> [(i32, i32); 3] {
+        match self {
+            StreakSide::Left => [(-1, -1), (-1, 0), (-1, 1)],
+            StreakSide::Right => [(1, -1), (1, 0), (1, 1)],
+            StreakSide::Top => [(-1, -1), (0, -1), (1, -1)],
+            StreakSide::Bottom => [(-1, 1), (0, 1), (1, 1)],
+        }
+    }
+}
+
+impl StreakObservation {
+    /// Builds an observation from a streak's pixels: the edge pixels by METHOD §5 step 6 (a
+    /// pixel is a left-edge pixel when none of its three left neighbours belongs to the
+    /// streak; outside the image counts as not belonging), and the brightest pixel by the
+    /// luminance of `radiance` (the streak extraction picks it per superpixel instead).
+    ///
+    /// Returns `None` when `pixels` is empty or holds an index outside the image.
+    pub fn from_pixels(
+        id: usize,
+        mut pixels: Vec<u32>,
+        width: u32,
+        height: u32,
+        radiance: &[[f32; 3]],
+    ) -> Option<Self> {
+        let n = width as usize * height as usize;
+        pixels.sort_unstable();
+        pixels.dedup();
+        if pixels.is_empty() || pixels.iter().any(|&p| p as usize >= n.min(radiance.len())) {
+            return None;
+        }
+        let mut member = vec![false; n];
+        for &p in &pixels {
+            member[p as usize] = true;
+        }
+        let edges = StreakSide::ALL.map(|side| {
+            pixels
+                .iter()
+                .copied()
+                .filter(|&p| {
+                    side.outward_neighbours().iter().all(|&(dx, dy)| {
+                        neighbour(p, dx, dy, width, height).is_none_or(|q| !member[q as usize])
+                    })
+                })
+                .collect()
+        });
+        let brightest = pixels.iter().copied().max_by(|&a, &b| {
+            luminance(radiance[a as usize]).total_cmp(&luminance(radiance[b as usize]))
+        })?;
+        Some(StreakObservation {
+            id,
+            pixels,
+            brightest,
+            edges,
+        })
+    }
+}
+
+/// The pixel at offset (dx, dy) from `p`, or `None` outside the image.
+pub fn neighbour(p: u32, dx: i32, dy: i32, width: u32, height: u32) -> Option<u32> {
+    let x = (p % width) as i64 + dx as i64;
+    let y = (p / width) as i64 + dy as i64;
+    if x < 0 || y < 0 || x >= width as i64 || y >= height as i64 {
+        None
+    } else {
+        Some((y as u32) * width + x as u32)
+    }
+}
+
+/// Rec. 709 luminance of linear RGB.
+pub fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}

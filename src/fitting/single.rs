@@ -1,0 +1,320 @@
+//! Fitting one streak: plane, footprints, then radiance and edges alternated until they agree.
+
+use std::time::Instant;
+
+use super::edges::{assign, combine, solve_edge, EdgeEstimate};
+use super::footprint::{footprints, Footprint};
+use super::light_plane::{find_plane, PlaneSearch};
+use super::observation::{neighbour, StreakObservation, StreakSide};
+use super::radiance::{bright_pixels, fit_radiance, observed_coefficient, RADIANCE_PIXELS};
+use super::rect::Rect;
+use super::{EdgeSide, EdgeStatus, FitOptions, FittedLight, Skipped};
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+
+/// Seconds spent per stage, summed over streaks.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StageTimes {
+    /// Finding light planes.
+    pub plane: f64,
+    /// Tracing footprints.
+    pub footprints: f64,
+    /// Radiance and edge iterations.
+    pub solve: f64,
+}
+
+/// At most this many radiance/edge alternations; they usually settle in 5-10.
+const MAX_ITERATIONS: usize = 40;
+/// Stop when no edge moved by more than this fraction of the rectangle's size.
+const TOLERANCE: f32 = 1e-4;
+/// Fewer valid edge pixels than this leave an edge unconstrained.
+const MIN_EDGE_PIXELS: usize = 3;
+/// An edge is unconstrained when more than this fraction of its pixels sit where the streak
+/// is cut by the photo's border or the water's end.
+const MAX_TRUNCATED_FRACTION: f32 = 0.25;
+
+/// A streak-edge pixel and its footprint.
+struct EdgePixel {
+    footprint: usize,
+    /// The streak continues past the photo's border or the water's end here: the pixel is
+    /// not on the streak's real edge.
+    truncated: bool,
+    /// The streak sides it is an edge pixel of (indexed by [`StreakSide`]).
+    sides: [bool; 4],
+}
+
+/// Fits the light of one streak.
+pub fn fit_streak(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    obs: &StreakObservation,
+    options: &FitOptions,
+    times: &mut StageTimes,
+) -> Result<FittedLight, Skipped> {
+    let (w, h) = (photo.width, photo.height);
+    let t = Instant::now();
+    let search = find_plane(
+        scene,
+        &options.model,
+        obs.brightest,
+        w,
+        h,
+        options.samples,
+        options.seed,
+    );
+    times.plane += t.elapsed().as_secs_f64();
+    let plane = match search {
+        PlaneSearch::Found(p) => p,
+        PlaneSearch::Nothing { rays, water_hits } => {
+            let (x, y) = (obs.brightest % w, obs.brightest / w);
+            return Err(Skipped::NoPlane {
+                streak: obs.id,
+                message: format!(
+                    "streak {} (brightest pixel x {x}, y {y}): none of the {rays} reflected rays \
+                     hit anything but {}; add the geometry the light hangs on (a wall, facade \
+                     or pole) to the scene",
+                    obs.id,
+                    if water_hits > 0 { "the water" } else { "the sky" }
+                ),
+            });
+        }
+    };
+
+    // Pixels to trace: every streak-edge pixel and the brightest interior ones.
+    let mut edge_pixels: Vec<(u32, bool, [bool; 4])> = Vec::new();
+    for (side, pixels) in StreakSide::ALL.iter().zip(&obs.edges) {
+        for &p in pixels {
+            if p as usize >= photo.clipped.len() || photo.clipped[p as usize] {
+                continue;
+            }
+            let truncated = side.outward_neighbours().iter().any(|&(dx, dy)| {
+                neighbour(p, dx, dy, w, h).is_none_or(|q| !water.get(q as usize).copied().unwrap_or(false))
+            });
+            let mut sides = [false; 4];
+            sides[*side as usize] = true;
+            edge_pixels.push((p, truncated, sides));
+        }
+    }
+    edge_pixels.sort_unstable_by_key(|e| e.0);
+    // A pixel on two sides (a corner) is traced once; it is truncated if either side is.
+    edge_pixels.dedup_by(|b, a| {
+        if a.0 == b.0 {
+            a.1 |= b.1;
+            for k in 0..4 {
+                a.2[k] |= b.2[k];
+            }
+            true
+        } else {
+            false
+        }
+    });
+    let bright = bright_pixels(obs, photo, RADIANCE_PIXELS);
+    if bright.is_empty() {
+        return Err(Skipped::NoSolution {
+            streak: obs.id,
+            message: format!("streak {}: every pixel is clipped; lower the exposure", obs.id),
+        });
+    }
+    let mut traced: Vec<u32> = edge_pixels.iter().map(|e| e.0).chain(bright.iter().copied()).collect();
+    traced.sort_unstable();
+    traced.dedup();
+    let t = Instant::now();
+    let fps = footprints(
+        scene,
+        &options.model,
+        &plane,
+        &traced,
+        w,
+        h,
+        options.samples,
+        options.seed,
+    );
+    times.footprints += t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let index_of = |p: u32| traced.binary_search(&p).ok();
+    let edges: Vec<EdgePixel> = edge_pixels
+        .iter()
+        .filter_map(|&(p, truncated, sides)| {
+            index_of(p).map(|footprint| EdgePixel {
+                footprint,
+                truncated,
+                sides,
+            })
+        })
+        .collect();
+    let bright_fps: Vec<&Footprint> = bright.iter().filter_map(|&p| index_of(p)).map(|i| &fps[i]).collect();
+
+    let result = solve(photo, obs, &fps, &edges, &bright_fps);
+    times.solve += t.elapsed().as_secs_f64();
+    let (rect, radiance, edge_status) = result?;
+    Ok(FittedLight {
+        streak_ids: vec![obs.id],
+        plane,
+        u_min: rect.u_min,
+        u_max: rect.u_max,
+        v_min: rect.v_min,
+        v_max: rect.v_max,
+        radiance,
+        edges: edge_status,
+    })
+}
+
+type Solution = (Rect, [f32; 3], [EdgeStatus; 4]);
+
+/// Alternates radiance and edges from an initial rectangle until they agree.
+fn solve(
+    photo: &Photo,
+    obs: &StreakObservation,
+    fps: &[Footprint],
+    edges: &[EdgePixel],
+    bright: &[&Footprint],
+) -> Result<Solution, Skipped> {
+    let no_solution = |what: &str| Skipped::NoSolution {
+        streak: obs.id,
+        message: format!("streak {}: {what}", obs.id),
+    };
+    let mut rect = initial_rect(fps, edges)
+        .ok_or_else(|| no_solution("no edge pixel's reflected rays reach the light's plane"))?;
+    let mut radiance = fit_radiance(photo, bright, None)
+        .ok_or_else(|| no_solution("the brightest pixels' reflected rays miss the light's plane"))?;
+    let far = far_extent(fps);
+    let mut status: [EdgeStatus; 4] = std::array::from_fn(|_| EdgeStatus::Constrained { pixels: 0 });
+    for _ in 0..MAX_ITERATIONS {
+        let before = rect;
+        // Who constrains what is decided once per pass, against the rectangle the pass
+        // starts from.
+        let mut assigned: [Vec<&EdgePixel>; 4] = Default::default();
+        for e in edges {
+            if let Some(side) = assign(&fps[e.footprint], &rect) {
+                assigned[side as usize].push(e);
+            }
+        }
+        for side in EdgeSide::ALL {
+            let pixels = &assigned[side as usize];
+            let truncated = pixels.iter().filter(|e| e.truncated).count();
+            let valid = pixels.len() - truncated;
+            status[side as usize] = if valid < MIN_EDGE_PIXELS {
+                EdgeStatus::Unconstrained {
+                    reason: format!(
+                        "only {valid} streak-edge pixels constrain the light's {} edge",
+                        side.name()
+                    ),
+                }
+            } else if truncated as f32 > MAX_TRUNCATED_FRACTION * pixels.len() as f32 {
+                EdgeStatus::Unconstrained {
+                    reason: format!(
+                        "the streak is cut by the photo's border or the water's end on the side \
+                         of the light's {} edge ({truncated} of {} pixels)",
+                        side.name(),
+                        pixels.len()
+                    ),
+                }
+            } else {
+                EdgeStatus::Constrained { pixels: valid }
+            };
+        }
+        for side in EdgeSide::ALL {
+            if let EdgeStatus::Unconstrained { .. } = status[side as usize] {
+                // The photo cannot tell where this edge is: put it as far as any traced
+                // pixel can see, so that it does not cut the other pixels' lobes short.
+                rect = rect.with_edge(side, far.edge(side));
+                continue;
+            }
+            let estimates: Vec<EdgeEstimate> = assigned[side as usize]
+                .iter()
+                .filter(|e| !e.truncated)
+                .filter_map(|e| {
+                    let fp = &fps[e.footprint];
+                    let coef = observed_coefficient(photo.radiance[fp.pixel as usize], radiance)?;
+                    solve_edge(fp, &rect, side, coef)
+                })
+                .collect();
+            if let Some(x) = combine(&estimates) {
+                let candidate = rect.with_edge(side, x);
+                if candidate.width() > 0.0 && candidate.height() > 0.0 {
+                    rect = candidate;
+                }
+            }
+        }
+        if let Some(l) = fit_radiance(photo, bright, Some(&rect)) {
+            radiance = l;
+        }
+        let size = rect.width().max(rect.height());
+        let moved = EdgeSide::ALL
+            .iter()
+            .map(|&s| (rect.edge(s) - before.edge(s)).abs())
+            .fold(0.0f32, f32::max);
+        if moved <= TOLERANCE * size {
+            break;
+        }
+    }
+    Ok((rect, radiance, status))
+}
+
+/// A first rectangle, larger than the light: on each side of the streak, a far percentile of
+/// where that side's edge pixels' lobes are centred, with the paper's mapping of streak sides
+/// to light sides (left to left, right to right, and the reflection's flip: the streak's top
+/// to the light's bottom). Edge pixels are dim, so their lobes are centred outside the light:
+/// the first pass sees every real edge pixel outside the rectangle, where the per-pixel
+/// assignment needs it.
+fn initial_rect(fps: &[Footprint], edges: &[EdgePixel]) -> Option<Rect> {
+    let side_values = |side: StreakSide, along_u: bool| -> Vec<f32> {
+        edges
+            .iter()
+            .filter(|e| e.sides[side as usize])
+            .filter_map(|e| fps[e.footprint].centroid())
+            .map(|c| if along_u { c.x } else { c.y })
+            .collect()
+    };
+    let pct = |mut xs: Vec<f32>, q: f32| -> Option<f32> {
+        if xs.is_empty() {
+            return None;
+        }
+        xs.sort_by(f32::total_cmp);
+        Some(xs[((xs.len() - 1) as f32 * q).round() as usize])
+    };
+    let all: Vec<glam::Vec2> = edges.iter().filter_map(|e| fps[e.footprint].centroid()).collect();
+    let all_u: Vec<f32> = all.iter().map(|c| c.x).collect();
+    let all_v: Vec<f32> = all.iter().map(|c| c.y).collect();
+    let mut r = Rect {
+        u_min: pct(side_values(StreakSide::Left, true), 0.1).or(pct(all_u.clone(), 0.03))?,
+        u_max: pct(side_values(StreakSide::Right, true), 0.9).or(pct(all_u, 0.97))?,
+        v_min: pct(side_values(StreakSide::Top, false), 0.1).or(pct(all_v.clone(), 0.03))?,
+        v_max: pct(side_values(StreakSide::Bottom, false), 0.9).or(pct(all_v, 0.97))?,
+    };
+    if r.u_min > r.u_max {
+        (r.u_min, r.u_max) = (r.u_max, r.u_min);
+    }
+    if r.v_min > r.v_max {
+        (r.v_min, r.v_max) = (r.v_max, r.v_min);
+    }
+    // A streak of one column still needs a rectangle with area to start from.
+    let min_size = 1e-3 * (1.0 + r.center().abs().max_element());
+    if r.width() < min_size {
+        let c = r.center().x;
+        (r.u_min, r.u_max) = (c - min_size, c + min_size);
+    }
+    if r.height() < min_size {
+        let c = r.center().y;
+        (r.v_min, r.v_max) = (c - min_size, c + min_size);
+    }
+    Some(r)
+}
+
+/// The box of every sample landing point: as far as the traced pixels can see.
+fn far_extent(fps: &[Footprint]) -> Rect {
+    let mut r = Rect {
+        u_min: f32::INFINITY,
+        u_max: f32::NEG_INFINITY,
+        v_min: f32::INFINITY,
+        v_max: f32::NEG_INFINITY,
+    };
+    for p in fps.iter().flat_map(|f| &f.points) {
+        r.u_min = r.u_min.min(p.x);
+        r.u_max = r.u_max.max(p.x);
+        r.v_min = r.v_min.min(p.y);
+        r.v_max = r.v_max.max(p.y);
+    }
+    r
+}
