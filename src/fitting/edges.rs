@@ -70,7 +70,14 @@ pub fn solve_edge(fp: &Footprint, rect: &Rect, side: EdgeSide, coef: f32) -> Opt
         EdgeSide::Bottom => (1.0, false),
         EdgeSide::Top => (-1.0, false),
     };
-    let held = rect.with_edge(side, if sign > 0.0 { f32::NEG_INFINITY } else { f32::INFINITY });
+    let held = rect.with_edge(
+        side,
+        if sign > 0.0 {
+            f32::NEG_INFINITY
+        } else {
+            f32::INFINITY
+        },
+    );
     let mut relevant: Vec<(f32, f32)> = fp
         .points
         .iter()
@@ -130,7 +137,10 @@ pub fn combine(estimates: &[EdgeEstimate]) -> Option<f32> {
         .iter()
         .filter(|e| (e.position - median).abs() <= limit)
         .fold((0f64, 0f64), |(s, ws), e| {
-            (s + e.position as f64 * e.weight as f64, ws + e.weight as f64)
+            (
+                s + e.position as f64 * e.weight as f64,
+                ws + e.weight as f64,
+            )
         });
     (wsum > 0.0).then(|| (sum / wsum) as f32)
 }

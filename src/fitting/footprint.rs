@@ -110,7 +110,7 @@ pub fn footprint(
         else {
             continue;
         };
-        if let SceneHit::Surface(hit) = trace(scene, start, sample.wi, 0.0) {
+        if let SceneHit::Surface(hit) = trace(scene, &[], start, sample.wi, 0.0) {
             if plane.contains_triangle(scene, hit.triangle) {
                 fp.points.push(plane.coords(start + sample.wi * hit.t));
                 fp.weights.push(sample.weight);

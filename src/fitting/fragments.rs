@@ -33,7 +33,11 @@ fn overlaps_in_plane(a: &FittedLight, b: &FittedLight) -> bool {
 
 /// The union of two streaks' pixels as one observation: edges recomputed for the union (an edge
 /// pixel of one piece can be inside the other), brightest pixel the brighter of the two.
-pub fn merge(a: &StreakObservation, b: &StreakObservation, photo: &Photo) -> Option<StreakObservation> {
+pub fn merge(
+    a: &StreakObservation,
+    b: &StreakObservation,
+    photo: &Photo,
+) -> Option<StreakObservation> {
     let pixels: Vec<u32> = a.pixels.iter().chain(&b.pixels).copied().collect();
     let mut merged = StreakObservation::from_pixels(
         a.id.min(b.id),
@@ -42,7 +46,12 @@ pub fn merge(a: &StreakObservation, b: &StreakObservation, photo: &Photo) -> Opt
         photo.height,
         &photo.radiance,
     )?;
-    let lum = |p: u32| photo.radiance.get(p as usize).map_or(0.0, |&c| luminance(c));
+    let lum = |p: u32| {
+        photo
+            .radiance
+            .get(p as usize)
+            .map_or(0.0, |&c| luminance(c))
+    };
     merged.brightest = if lum(a.brightest) >= lum(b.brightest) {
         a.brightest
     } else {

@@ -235,7 +235,9 @@ pub fn fit_paper(
         )));
     }
     if options.samples == 0 {
-        return Err(Error::Usage("the fit needs at least one sample per pixel".into()));
+        return Err(Error::Usage(
+            "the fit needs at least one sample per pixel".into(),
+        ));
     }
     for s in streaks {
         let bad = s
@@ -270,7 +272,12 @@ pub fn fit_paper(
         };
         let (obs_j, light_j) = fitted.remove(j);
         let (obs_i, light_i) = fitted.remove(i);
-        let mut ids: Vec<usize> = light_i.streak_ids.iter().chain(&light_j.streak_ids).copied().collect();
+        let mut ids: Vec<usize> = light_i
+            .streak_ids
+            .iter()
+            .chain(&light_j.streak_ids)
+            .copied()
+            .collect();
         ids.sort_unstable();
         let merged = fragments::merge(&obs_i, &obs_j, photo);
         match merged.map(|m| {

@@ -51,7 +51,11 @@ pub fn bright_pixels(obs: &StreakObservation, photo: &Photo, count: usize) -> Ve
 
 /// Least-squares radiance per channel, `L_c = sum I_c c / sum c^2`, over `footprints` with the
 /// light covering `rect` (the whole plane when `None`). `None` when no pixel sees the light.
-pub fn fit_radiance(photo: &Photo, footprints: &[&Footprint], rect: Option<&Rect>) -> Option<[f32; 3]> {
+pub fn fit_radiance(
+    photo: &Photo,
+    footprints: &[&Footprint],
+    rect: Option<&Rect>,
+) -> Option<[f32; 3]> {
     let mut num = [0f64; 3];
     let mut den = 0f64;
     for fp in footprints {

@@ -64,22 +64,23 @@ pub fn fit_streak(
         options.seed,
     );
     times.plane += t.elapsed().as_secs_f64();
-    let plane = match search {
-        PlaneSearch::Found(p) => p,
-        PlaneSearch::Nothing { rays, water_hits } => {
-            let (x, y) = (obs.brightest % w, obs.brightest / w);
-            return Err(Skipped::NoPlane {
-                streak: obs.id,
-                message: format!(
+    let plane =
+        match search {
+            PlaneSearch::Found(p) => p,
+            PlaneSearch::Nothing { rays, water_hits } => {
+                let (x, y) = (obs.brightest % w, obs.brightest / w);
+                return Err(Skipped::NoPlane {
+                    streak: obs.id,
+                    message: format!(
                     "streak {} (brightest pixel x {x}, y {y}): none of the {rays} reflected rays \
                      hit anything but {}; add the geometry the light hangs on (a wall, facade \
                      or pole) to the scene",
                     obs.id,
                     if water_hits > 0 { "the water" } else { "the sky" }
                 ),
-            });
-        }
-    };
+                });
+            }
+        };
 
     // Pixels to trace: every streak-edge pixel and the brightest interior ones.
     let mut edge_pixels: Vec<(u32, bool, [bool; 4])> = Vec::new();
@@ -89,7 +90,8 @@ pub fn fit_streak(
                 continue;
             }
             let truncated = side.outward_neighbours().iter().any(|&(dx, dy)| {
-                neighbour(p, dx, dy, w, h).is_none_or(|q| !water.get(q as usize).copied().unwrap_or(false))
+                neighbour(p, dx, dy, w, h)
+                    .is_none_or(|q| !water.get(q as usize).copied().unwrap_or(false))
             });
             let mut sides = [false; 4];
             sides[*side as usize] = true;
@@ -113,10 +115,17 @@ pub fn fit_streak(
     if bright.is_empty() {
         return Err(Skipped::NoSolution {
             streak: obs.id,
-            message: format!("streak {}: every pixel is clipped; lower the exposure", obs.id),
+            message: format!(
+                "streak {}: every pixel is clipped; lower the exposure",
+                obs.id
+            ),
         });
     }
-    let mut traced: Vec<u32> = edge_pixels.iter().map(|e| e.0).chain(bright.iter().copied()).collect();
+    let mut traced: Vec<u32> = edge_pixels
+        .iter()
+        .map(|e| e.0)
+        .chain(bright.iter().copied())
+        .collect();
     traced.sort_unstable();
     traced.dedup();
     let t = Instant::now();
@@ -143,7 +152,11 @@ pub fn fit_streak(
             })
         })
         .collect();
-    let bright_fps: Vec<&Footprint> = bright.iter().filter_map(|&p| index_of(p)).map(|i| &fps[i]).collect();
+    let bright_fps: Vec<&Footprint> = bright
+        .iter()
+        .filter_map(|&p| index_of(p))
+        .map(|i| &fps[i])
+        .collect();
 
     let result = solve(photo, obs, &fps, &edges, &bright_fps);
     times.solve += t.elapsed().as_secs_f64();
@@ -176,10 +189,12 @@ fn solve(
     };
     let mut rect = initial_rect(fps, edges)
         .ok_or_else(|| no_solution("no edge pixel's reflected rays reach the light's plane"))?;
-    let mut radiance = fit_radiance(photo, bright, None)
-        .ok_or_else(|| no_solution("the brightest pixels' reflected rays miss the light's plane"))?;
+    let mut radiance = fit_radiance(photo, bright, None).ok_or_else(|| {
+        no_solution("the brightest pixels' reflected rays miss the light's plane")
+    })?;
     let far = far_extent(fps);
-    let mut status: [EdgeStatus; 4] = std::array::from_fn(|_| EdgeStatus::Constrained { pixels: 0 });
+    let mut status: [EdgeStatus; 4] =
+        std::array::from_fn(|_| EdgeStatus::Constrained { pixels: 0 });
     for _ in 0..MAX_ITERATIONS {
         let before = rect;
         // Who constrains what is decided once per pass, against the rectangle the pass
@@ -274,7 +289,10 @@ fn initial_rect(fps: &[Footprint], edges: &[EdgePixel]) -> Option<Rect> {
         xs.sort_by(f32::total_cmp);
         Some(xs[((xs.len() - 1) as f32 * q).round() as usize])
     };
-    let all: Vec<glam::Vec2> = edges.iter().filter_map(|e| fps[e.footprint].centroid()).collect();
+    let all: Vec<glam::Vec2> = edges
+        .iter()
+        .filter_map(|e| fps[e.footprint].centroid())
+        .collect();
     let all_u: Vec<f32> = all.iter().map(|c| c.x).collect();
     let all_v: Vec<f32> = all.iter().map(|c| c.y).collect();
     let mut r = Rect {
