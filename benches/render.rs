@@ -24,7 +24,13 @@ fn main() {
         ..Default::default()
     };
     // One warm-up run, then the best of three.
-    let _ = render(&scene, &RenderOptions { samples_per_pixel: 4, ..options.clone() });
+    let _ = render(
+        &scene,
+        &RenderOptions {
+            samples_per_pixel: 4,
+            ..options.clone()
+        },
+    );
     let mut best: Option<streaklight::render::Rendered> = None;
     for _ in 0..3 {
         let r = render(&scene, &options).expect("rendering");
@@ -34,7 +40,10 @@ fn main() {
     }
     let r = best.expect("three runs");
     println!("threads: {}", rayon::current_num_threads());
-    println!("scene generation: {generate:.3} s; load + BVH build ({} triangles): {load_s:.3} s", scene.triangles.len());
+    println!(
+        "scene generation: {generate:.3} s; load + BVH build ({} triangles): {load_s:.3} s",
+        scene.triangles.len()
+    );
     println!(
         "render 600x600 @ 64 spp: {:.3} s; camera rays {:.2} M/s; reflected rays {} ({:.2} M/s)",
         r.seconds,

@@ -11,9 +11,11 @@
 //! | reflection model (§4) | [`optics`] |
 //! | 7-9. light plane, radiance, edges | [`fitting`] |
 //! | 10. write the lights back | [`scene_out`] |
+//! | the whole converter, end to end | [`convert`], [`report`] |
 //! | rendering a lit scene (to make and check photos) | [`render`], [`photo_out`] |
 //! | sample scenes of the paper's setup | [`samples`] |
 
+pub mod convert;
 pub mod error;
 pub mod fitting;
 pub mod optics;
@@ -22,9 +24,11 @@ pub mod photo_in;
 pub mod photo_out;
 pub mod random;
 pub mod render;
+pub mod report;
 pub mod samples;
 pub mod scene_in;
 pub mod scene_out;
+pub mod streaks;
 pub mod tracing;
 pub mod water_mask;
 

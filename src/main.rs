@@ -13,6 +13,8 @@ mod cli;
     about = "Fit rectangle area lights to the reflections of lights on night water, and write them into a glTF scene"
 )]
 enum Command {
+    /// Fit rectangle area lights to the streaks of a photo and write them into the scene.
+    Fit(cli::fit::Args),
     /// Find the streaks (reflections of lights) in a photo and draw pictures of every stage.
     Segment(cli::segment::Args),
     /// Render the water and the EXT_lights_area lights of a scene as its camera sees them.
@@ -23,6 +25,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let result = match Command::parse() {
+        Command::Fit(args) => cli::fit::run(args),
         Command::Segment(args) => cli::segment::run(args),
         Command::Render(args) => cli::render::run(args),
         Command::Samples(args) => cli::samples::run(args),

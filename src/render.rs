@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use crate::optics::{ReflectionModel, Shadowing};
 use crate::random::Rng;
-use crate::scene_in::Scene;
+use crate::scene_in::{AreaLight, Scene};
 use crate::{Error, Result};
 
 /// How to render.
@@ -25,7 +25,8 @@ pub struct RenderOptions {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Camera rays per pixel.
+    /// Samples per pixel: lobe samples on the water, split over jittered camera rays
+    /// (see [`camera_rays_per_pixel`]).
     pub samples_per_pixel: u32,
     /// Multiplies radiance before it is stored (the photo's exposure).
     pub exposure: f32,
@@ -82,15 +83,38 @@ pub enum SceneHit {
 /// coplanar with it; without a margin the wall would hide them by rounding.
 const LIGHT_TIE_MARGIN: f32 = 1e-4;
 
-/// Traces a ray against the scene's triangles and area lights.
-pub fn trace(scene: &Scene, origin: Vec3, dir: Vec3, tmin: f32) -> SceneHit {
-    let mut nearest_light: Option<(usize, f32)> = None;
-    for (i, light) in scene.area_lights.iter().enumerate() {
-        let limit = nearest_light.map_or(f32::INFINITY, |(_, t)| t);
+/// The nearest light whose emitting face the ray hits, and the distance to it.
+fn nearest_light(lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin: f32) -> Option<(usize, f32)> {
+    let mut nearest: Option<(usize, f32)> = None;
+    for (i, light) in lights.iter().enumerate() {
+        let limit = nearest.map_or(f32::INFINITY, |(_, t)| t);
         if let Some(t) = light.intersect(origin, dir, tmin, limit) {
-            nearest_light = Some((i, t));
+            nearest = Some((i, t));
         }
     }
+    nearest
+}
+
+/// The light a ray sees, if any: the nearest light it hits, unless geometry is nearer. Only
+/// an occlusion query is needed, and none at all for a ray that misses every light, which
+/// is most reflected rays.
+pub fn visible_light(
+    scene: &Scene,
+    lights: &[AreaLight],
+    origin: Vec3,
+    dir: Vec3,
+    tmin: f32,
+) -> Option<usize> {
+    let (i, t) = nearest_light(lights, origin, dir, tmin)?;
+    (!scene
+        .tracer
+        .occluded(origin, dir, tmin, t * (1.0 - LIGHT_TIE_MARGIN)))
+    .then_some(i)
+}
+
+/// Traces a ray against the scene's triangles and the area lights `lights`.
+pub fn trace(scene: &Scene, lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin: f32) -> SceneHit {
+    let nearest_light = nearest_light(lights, origin, dir, tmin);
     let tmax = nearest_light.map_or(f32::INFINITY, |(_, t)| t * (1.0 - LIGHT_TIE_MARGIN));
     match scene.tracer.closest_hit(origin, dir, tmin, tmax) {
         Some(hit) => SceneHit::Surface(hit),
@@ -109,6 +133,15 @@ pub fn surface_offset(p: Vec3) -> f32 {
 
 /// Renders the scene's water and lights as the camera sees them.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
+    render_with_lights(scene, &scene.area_lights, options)
+}
+
+/// Renders the scene's water under `lights` instead of the scene's own (to check a fit).
+pub fn render_with_lights(
+    scene: &Scene,
+    lights: &[AreaLight],
+    options: &RenderOptions,
+) -> Result<Rendered> {
     let (w, h) = (options.width, options.height);
     if w == 0 || h == 0 || w > 32768 || h > 32768 {
         return Err(Error::Usage(format!(
@@ -142,15 +175,31 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
                 let index = y as u64 * w as u64 + x as u64;
                 let mut rng = Rng::new(options.seed, index);
                 let mut sum = [0f64; 3];
-                for _ in 0..options.samples_per_pixel {
-                    let (value, reflected_ray) =
-                        pixel_sample(scene, &model, x as u32, y as u32, w, h, &mut rng);
-                    row_reflected += reflected_ray as u64;
+                let camera_rays = camera_rays_per_pixel(options.samples_per_pixel);
+                let lobe_samples = options.samples_per_pixel / camera_rays;
+                let strata = (camera_rays as f32).sqrt() as u32;
+                for k in 0..camera_rays {
+                    let (value, traced) = pixel_sample(
+                        scene,
+                        lights,
+                        &model,
+                        PixelSample {
+                            x: x as u32,
+                            y: y as u32,
+                            stratum: k,
+                            strata,
+                            lobe_samples,
+                        },
+                        w,
+                        h,
+                        &mut rng,
+                    );
+                    row_reflected += traced as u64;
                     for c in 0..3 {
                         sum[c] += value[c] as f64;
                     }
                 }
-                let scale = options.exposure as f64 / options.samples_per_pixel as f64;
+                let scale = options.exposure as f64 / camera_rays as f64;
                 *out = sum.map(|s| (s * scale) as f32);
             }
             reflected.fetch_add(row_reflected, Ordering::Relaxed);
@@ -161,58 +210,99 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
         width: w,
         height: h,
         pixels,
-        camera_rays: w as u64 * h as u64 * options.samples_per_pixel as u64,
+        camera_rays: w as u64 * h as u64 * camera_rays_per_pixel(options.samples_per_pixel) as u64,
         reflected_rays: reflected.into_inner(),
         seconds: start.elapsed().as_secs_f64(),
     })
 }
 
-/// One camera sample of pixel (x, y): the radiance it carries and whether a reflected ray
-/// was traced.
-fn pixel_sample(
-    scene: &Scene,
-    model: &ReflectionModel,
+/// Lobe samples traced from each camera ray's water hit. Tracing the camera ray is as costly
+/// as tracing a reflected one, and the pixel's value varies far more over the reflection lobe
+/// than over the pixel's footprint, so each camera ray is shared by a few lobe samples.
+pub const LOBE_SAMPLES_PER_CAMERA_RAY: u32 = 4;
+
+/// Camera rays per pixel for `samples_per_pixel` samples: the samples are split into camera
+/// rays of [`LOBE_SAMPLES_PER_CAMERA_RAY`] lobe samples each (one lobe sample each when there
+/// are too few samples to split).
+pub fn camera_rays_per_pixel(samples_per_pixel: u32) -> u32 {
+    if samples_per_pixel >= LOBE_SAMPLES_PER_CAMERA_RAY * 4 {
+        samples_per_pixel / LOBE_SAMPLES_PER_CAMERA_RAY
+    } else {
+        samples_per_pixel
+    }
+}
+
+/// Which camera ray of a pixel to trace.
+struct PixelSample {
     x: u32,
     y: u32,
+    /// Index of the camera ray within the pixel.
+    stratum: u32,
+    /// The pixel is split into strata x strata cells for the first strata^2 camera rays, so
+    /// that the footprint is covered evenly (the rest are uniformly jittered).
+    strata: u32,
+    /// Lobe samples to average at the water hit.
+    lobe_samples: u32,
+}
+
+/// One camera ray of a pixel: the mean radiance its lobe samples carry, and how many
+/// reflected rays were traced.
+fn pixel_sample(
+    scene: &Scene,
+    lights: &[AreaLight],
+    model: &ReflectionModel,
+    s: PixelSample,
     w: u32,
     h: u32,
     rng: &mut Rng,
-) -> ([f32; 3], bool) {
-    let jx = x as f32 + rng.next_f32();
-    let jy = y as f32 + rng.next_f32();
-    let u = Vec2::new(rng.next_f32(), rng.next_f32());
+) -> ([f32; 3], u32) {
+    let (mut fx, mut fy) = (rng.next_f32(), rng.next_f32());
+    if s.stratum < s.strata * s.strata {
+        let n = s.strata as f32;
+        fx = ((s.stratum % s.strata) as f32 + fx) / n;
+        fy = ((s.stratum / s.strata) as f32 + fy) / n;
+    }
     let origin = scene.camera.position;
-    let dir = scene.camera.direction(jx, jy, w, h);
-    let hit = match trace(scene, origin, dir, 0.0) {
-        SceneHit::Light(i) => return (scene.area_lights[i].radiance, false),
-        SceneHit::Miss => return ([0.0; 3], false),
+    let dir = scene
+        .camera
+        .direction(s.x as f32 + fx, s.y as f32 + fy, w, h);
+    let hit = match trace(scene, lights, origin, dir, 0.0) {
+        SceneHit::Light(i) => return (lights[i].radiance, 0),
+        SceneHit::Miss => return ([0.0; 3], 0),
         SceneHit::Surface(hit) => hit,
     };
     if !scene.is_water[hit.triangle as usize] {
-        return ([0.0; 3], false);
+        return ([0.0; 3], 0);
     }
     let p = origin + dir * hit.t;
     let wo = -dir;
     let n = scene.shading_normal(hit.triangle, hit.barycentric);
-    let Some(sample) = model.sample(n, wo, u) else {
-        return ([0.0; 3], false);
-    };
     let mut face = scene.face_normal(hit.triangle);
     if face.dot(wo) < 0.0 {
         face = -face;
     }
-    // A reflected ray that would enter the water geometrically sees nothing.
-    if face.dot(sample.wi) <= 0.0 {
-        return ([0.0; 3], false);
-    }
     let start = p + face * surface_offset(p);
-    match trace(scene, start, sample.wi, 0.0) {
-        SceneHit::Light(i) => {
-            let l = scene.area_lights[i].radiance;
-            (l.map(|c| c * sample.weight), true)
+    let mut sum = [0f32; 3];
+    let mut traced = 0;
+    for _ in 0..s.lobe_samples {
+        let u = Vec2::new(rng.next_f32(), rng.next_f32());
+        let Some(sample) = model.sample(n, wo, u) else {
+            continue;
+        };
+        // A reflected ray that would enter the water geometrically sees nothing.
+        if face.dot(sample.wi) <= 0.0 {
+            continue;
         }
-        _ => ([0.0; 3], true),
+        traced += 1;
+        if let Some(i) = visible_light(scene, lights, start, sample.wi, 0.0) {
+            let l = lights[i].radiance;
+            for c in 0..3 {
+                sum[c] += l[c] * sample.weight;
+            }
+        }
     }
+    let inv = 1.0 / s.lobe_samples as f32;
+    (sum.map(|c| c * inv), traced)
 }
 
 fn progress_bar(enabled: bool, rows: u64) -> indicatif::ProgressBar {

@@ -1,5 +1,6 @@
 //! One file per subcommand: its arguments and a `run` that calls the library.
 
+pub mod fit;
 pub mod render;
 pub mod samples;
 pub mod segment;

@@ -161,7 +161,7 @@ pub fn find_plane(
             continue;
         };
         rays += 1;
-        let SceneHit::Surface(hit) = trace(scene, start, wi, 0.0) else {
+        let SceneHit::Surface(hit) = trace(scene, &[], start, wi, 0.0) else {
             continue;
         };
         if scene.is_water[hit.triangle as usize] {
@@ -238,7 +238,7 @@ pub fn reflected_sample(
     let u = Vec2::new(rng.next_f32(), rng.next_f32());
     let origin = scene.camera.position;
     let dir = scene.camera.direction(jx, jy, width, height);
-    let SceneHit::Surface(hit) = trace(scene, origin, dir, 0.0) else {
+    let SceneHit::Surface(hit) = trace(scene, &[], origin, dir, 0.0) else {
         return None;
     };
     if !scene.is_water[hit.triangle as usize] {

@@ -271,3 +271,6 @@ pub fn run_cli(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// Synthetic images with known regions (SLIC tests and benchmark).
+pub mod shapes;

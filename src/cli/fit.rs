@@ -1,0 +1,116 @@
+//! `streaklight fit SCENE PHOTO -o OUT`: the main job.
+
+use std::path::PathBuf;
+
+use streaklight::convert::{convert, describe, ConvertOptions};
+use streaklight::optics::Shadowing;
+use streaklight::scene_in::LoadOptions;
+
+/// Arguments of `streaklight fit`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The glTF scene (.gltf or .glb): a camera, the water, and the geometry lights hang on.
+    pub scene: PathBuf,
+    /// The night photo of the water, taken from the scene's camera (PNG, JPEG, TIFF, EXR, HDR).
+    pub photo: PathBuf,
+    /// The lit scene to write: .gltf or .glb (never over an input).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write a JSON report of the lights, settings and timings here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Write pictures of every stage into this folder (superpixels, seeds, streaks, edges, and
+    /// the photo beside the water re-rendered with the fitted lights).
+    #[arg(long)]
+    pub debug_dir: Option<PathBuf>,
+    /// Blinn-Phong gloss e of the water, overriding its material's roughness.
+    #[arg(long)]
+    pub gloss: Option<f32>,
+    /// Index of refraction of the water (default: its material's KHR_materials_ior, else 1.33).
+    #[arg(long)]
+    pub ior: Option<f32>,
+    /// The photo's exposure: its linear values are divided by it to give radiance.
+    #[arg(long, default_value_t = 1.0)]
+    pub exposure: f32,
+    /// Lobe samples per traced pixel.
+    #[arg(long, default_value_t = streaklight::fitting::DEFAULT_SAMPLES)]
+    pub samples: u32,
+    /// Seed of every random number: the same inputs and seed give the same output.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Water node or mesh name (default: the one mesh node whose name contains "water").
+    #[arg(long)]
+    pub water: Option<String>,
+    /// Camera node or camera name (default: the first camera of the default scene).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Do not add emissive fallback quads for viewers without area lights.
+    #[arg(long)]
+    pub no_fallback_quads: bool,
+    /// Light intensity units per unit of radiance (683 turns W/(sr m^2) into nits).
+    #[arg(long, default_value_t = 1.0)]
+    pub nits_scale: f64,
+    /// Use Smith shadowing in the reflection model (default: the paper's G = 1).
+    #[arg(long)]
+    pub smith: bool,
+    /// Succeed and write the scene unchanged when no light is found.
+    #[arg(long)]
+    pub allow_empty: bool,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> streaklight::Result<()> {
+    let options = ConvertOptions {
+        scene: args.scene,
+        photo: args.photo,
+        output: args.output,
+        report: args.report,
+        debug_dir: args.debug_dir,
+        load: LoadOptions {
+            camera: args.camera,
+            water: args.water,
+            gloss: args.gloss,
+            ior: args.ior,
+            nits_scale: args.nits_scale,
+        },
+        exposure: args.exposure,
+        samples: args.samples,
+        seed: args.seed,
+        shadowing: if args.smith {
+            Shadowing::Smith
+        } else {
+            Shadowing::None
+        },
+        fallback_quads: !args.no_fallback_quads,
+        allow_empty: args.allow_empty,
+        streak_params: Default::default(),
+    };
+    let outcome = convert(&options)?;
+    for w in &outcome.report.warnings {
+        eprintln!("warning: {w}");
+    }
+    for light in &outcome.report.lights {
+        eprintln!(
+            "{}: streak(s) {:?}, corner ({:.4}, {:.4}, {:.4}), {:.4} x {:.4} m, radiance ({:.4}, {:.4}, {:.4})",
+            light.name,
+            light.streak_ids,
+            light.corner_left_bottom[0],
+            light.corner_left_bottom[1],
+            light.corner_left_bottom[2],
+            light.width,
+            light.height,
+            light.radiance[0],
+            light.radiance[1],
+            light.radiance[2]
+        );
+    }
+    let _ = describe;
+    let total: f64 = outcome.report.timings.iter().map(|t| t.seconds).sum();
+    eprintln!(
+        "wrote {} with {} light(s) in {:.2} s",
+        options.output.display(),
+        outcome.report.lights.len(),
+        total
+    );
+    Ok(())
+}

@@ -1,0 +1,483 @@
+//! The whole converter, end to end (METHOD §5): scene and photo in, lights fitted to the
+//! photo's streaks, the lit scene and a report out. The command line's `fit` is a thin wrapper
+//! around [`convert`]; pipelines can call it from Rust.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::DVec3;
+
+use crate::fitting::{self, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
+use crate::optics::{ReflectionModel, Shadowing};
+use crate::photo_in::{self, Photo};
+use crate::report::{
+    EdgeReport, EdgesReport, Files, LightReport, PlaneReport, Report, Settings, SkippedStreak,
+    Timing, REPORT_VERSION,
+};
+use crate::scene_in::{self, AreaLight, LoadOptions, Scene};
+use crate::scene_out::{self, LightToWrite, WriteOptions};
+use crate::streaks::{self, Segmentation, StreakParams};
+use crate::{output_file, photo_out, render, water_mask, Error, Result};
+
+/// The smallest photo the method can work with: superpixels of ~20 pixels need room.
+pub const MIN_PHOTO_SIDE: u32 = 64;
+/// How far the photo's aspect ratio may differ from the camera's (METHOD §2).
+pub const ASPECT_TOLERANCE: f32 = 0.005;
+
+/// Everything `fit` needs.
+#[derive(Clone, Debug)]
+pub struct ConvertOptions {
+    /// The input scene.
+    pub scene: PathBuf,
+    /// The photo of the water.
+    pub photo: PathBuf,
+    /// The output scene (`.gltf` or `.glb`).
+    pub output: PathBuf,
+    /// Where to write the JSON report, if anywhere.
+    pub report: Option<PathBuf>,
+    /// Where to write pictures of every stage, if anywhere.
+    pub debug_dir: Option<PathBuf>,
+    /// Camera, water, gloss, IOR and nits-scale choices.
+    pub load: LoadOptions,
+    /// Divides the photo's linear values.
+    pub exposure: f32,
+    /// Lobe samples per traced pixel.
+    pub samples: u32,
+    /// Seed of every random number.
+    pub seed: u64,
+    /// Shadowing term of the reflection model.
+    pub shadowing: Shadowing,
+    /// Write emissive fallback quads under the lights.
+    pub fallback_quads: bool,
+    /// Succeed (writing the scene unchanged) when no light is found.
+    pub allow_empty: bool,
+    /// Settings of the streak extraction.
+    pub streak_params: StreakParams,
+}
+
+/// What a conversion produced.
+#[derive(Clone, Debug)]
+pub struct ConvertOutcome {
+    /// The report (also written to [`ConvertOptions::report`] when set).
+    pub report: Report,
+    /// The fitted lights, in the scene frame of the loaded scene.
+    pub lights: Vec<FittedLight>,
+}
+
+struct Stopwatch(Vec<Timing>);
+
+impl Stopwatch {
+    fn time<T>(&mut self, stage: &str, f: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = f();
+        self.0.push(Timing {
+            stage: stage.into(),
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        out
+    }
+}
+
+/// Checks the output path before any work, so a long run does not end in a refusal.
+fn check_output(options: &ConvertOptions) -> Result<()> {
+    let ext = options
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("gltf") | Some("glb")) {
+        return Err(Error::output(
+            &options.output,
+            "the output must end in .gltf or .glb",
+        ));
+    }
+    let inputs = [options.scene.as_path(), options.photo.as_path()];
+    output_file::ensure_not_an_input(&options.output, &inputs)?;
+    if let Some(report) = &options.report {
+        output_file::ensure_not_an_input(report, &inputs)?;
+        output_file::ensure_not_an_input(report, &[options.output.as_path()])?;
+    }
+    Ok(())
+}
+
+/// Checks that the photo can have been taken by the scene's camera.
+pub fn check_photo(scene: &Scene, photo: &Photo, path: &Path) -> Result<()> {
+    if photo.width < MIN_PHOTO_SIDE || photo.height < MIN_PHOTO_SIDE {
+        return Err(Error::photo(
+            path,
+            format!(
+                "the photo is {} x {} pixels; streaklight needs at least {MIN_PHOTO_SIDE} x {MIN_PHOTO_SIDE}",
+                photo.width, photo.height
+            ),
+        ));
+    }
+    if let Some(camera_aspect) = scene.camera.aspect_ratio {
+        let photo_aspect = photo.width as f32 / photo.height as f32;
+        if ((photo_aspect - camera_aspect) / camera_aspect).abs() > ASPECT_TOLERANCE {
+            return Err(Error::photo(
+                path,
+                format!(
+                    "the photo's aspect ratio {photo_aspect:.4} ({} x {}) differs from the camera \"{}\"'s {camera_aspect:.4}: was it taken with another camera, or cropped?",
+                    photo.width, photo.height, scene.camera.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The fitter's view of a streak.
+fn observation(streak: &streaks::Streak, width: u32) -> StreakObservation {
+    StreakObservation {
+        id: streak.id,
+        pixels: streak.pixels.clone(),
+        brightest: streak.brightest.1 * width + streak.brightest.0,
+        edges: [
+            streak.edges.left.clone(),
+            streak.edges.right.clone(),
+            streak.edges.top.clone(),
+            streak.edges.bottom.clone(),
+        ],
+    }
+}
+
+/// A fitted light as a renderable area light (scene frame).
+pub fn area_light(light: &FittedLight, name: String) -> AreaLight {
+    let c = light.rect().center();
+    let plane = &light.plane;
+    AreaLight {
+        name,
+        node: plane.node,
+        center: plane.point + plane.u * c.x + plane.v * c.y,
+        half_width: plane.u * (light.width() * 0.5),
+        half_height: plane.v * (light.height() * 0.5),
+        normal: plane.normal,
+        radiance: light.radiance,
+    }
+}
+
+fn light_name(index: usize) -> String {
+    format!("streaklight_light_{index}")
+}
+
+fn edge_report(status: &EdgeStatus) -> EdgeReport {
+    match status {
+        EdgeStatus::Constrained { pixels } => EdgeReport {
+            status: "constrained".into(),
+            pixels: *pixels,
+            reason: None,
+        },
+        EdgeStatus::Unconstrained { reason } => EdgeReport {
+            status: "unconstrained".into(),
+            pixels: 0,
+            reason: Some(reason.clone()),
+        },
+    }
+}
+
+fn light_report(scene: &Scene, light: &FittedLight, name: String) -> LightReport {
+    let origin = scene.origin;
+    let v3 = |v: glam::Vec3| v.as_dvec3().to_array();
+    let radiance = light.radiance.map(f64::from);
+    LightReport {
+        name,
+        streak_ids: light.streak_ids.clone(),
+        plane: PlaneReport {
+            node: light.plane.node,
+            node_name: scene.node_names.get(light.plane.node).cloned().flatten(),
+            point: (origin + light.plane.point.as_dvec3()).to_array(),
+            normal: v3(light.plane.normal),
+            hit_fraction: light.plane.hit_fraction as f64,
+        },
+        center: light.center_world(origin).to_array(),
+        corner_left_bottom: light.corner_left_bottom_world(origin).to_array(),
+        u_axis: v3(light.plane.u),
+        v_axis: v3(light.plane.v),
+        width: light.width() as f64,
+        height: light.height() as f64,
+        radiance,
+        edges: EdgesReport {
+            left: edge_report(&light.edges[0]),
+            right: edge_report(&light.edges[1]),
+            bottom: edge_report(&light.edges[2]),
+            top: edge_report(&light.edges[3]),
+        },
+        light_index: None,
+        node_index: None,
+    }
+}
+
+fn light_to_write(scene: &Scene, light: &FittedLight, name: String) -> LightToWrite {
+    let streak_id = light.streak_ids.first().copied();
+    LightToWrite {
+        name,
+        center: light.center_world(scene.origin),
+        normal: light.plane.normal.as_dvec3().normalize(),
+        up: light.plane.v.as_dvec3().normalize(),
+        width: light.width() as f64,
+        height: light.height() as f64,
+        radiance: light.radiance.map(|c| f64::from(c.max(0.0))),
+        streak_id,
+    }
+}
+
+fn skipped_report(s: &Skipped) -> SkippedStreak {
+    match s {
+        Skipped::NoPlane { streak, message } | Skipped::NoSolution { streak, message } => {
+            SkippedStreak {
+                streak: *streak,
+                reason: message.clone(),
+            }
+        }
+    }
+}
+
+/// Runs the whole conversion.
+pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
+    check_output(options)?;
+    if options.samples == 0 {
+        return Err(Error::Usage("--samples must be at least 1".into()));
+    }
+    let mut clock = Stopwatch(Vec::new());
+    let scene = clock.time("load scene", || {
+        scene_in::load(&options.scene, &options.load)
+    })?;
+    let photo = clock.time("load photo", || {
+        photo_in::load(&options.photo, options.exposure)
+    })?;
+    check_photo(&scene, &photo, &options.photo)?;
+    let water = clock.time("water mask", || {
+        water_mask::water_mask(&scene, photo.width, photo.height)
+    });
+    if !water.iter().any(|&w| w) {
+        return Err(Error::scene(
+            &options.scene,
+            format!(
+                "the camera \"{}\" sees no water: check --camera and --water",
+                scene.camera.name
+            ),
+        ));
+    }
+    let segmentation = clock.time("streaks", || {
+        streaks::extract_streaks(&photo, &water, &options.streak_params)
+    })?;
+    let observations: Vec<StreakObservation> = segmentation
+        .streaks
+        .iter()
+        .map(|s| observation(s, photo.width))
+        .collect();
+    let fit_options = FitOptions {
+        samples: options.samples,
+        seed: options.seed,
+        model: ReflectionModel {
+            gloss: scene.water.gloss,
+            ior: scene.water.ior,
+            shadowing: options.shadowing,
+        },
+    };
+    let mut warnings: Vec<String> = scene.warnings.clone();
+    let fit = if observations.is_empty() {
+        None
+    } else {
+        Some(fitting::fit_paper(
+            &scene,
+            &photo,
+            &water,
+            &observations,
+            &fit_options,
+        )?)
+    };
+    let (lights, skipped) = match &fit {
+        Some(f) => {
+            clock
+                .0
+                .extend(f.timings.iter().map(|(stage, seconds)| Timing {
+                    stage: format!("fit: {stage}"),
+                    seconds: *seconds,
+                }));
+            warnings.extend(f.warnings.iter().cloned());
+            (
+                f.lights.clone(),
+                f.skipped.iter().map(skipped_report).collect(),
+            )
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    let nothing_found = lights.is_empty();
+    let nothing_message = if segmentation.streaks.is_empty() {
+        segmentation
+            .require_streaks()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_else(|| "no streak found".into())
+    } else {
+        format!(
+            "{} streak(s) found but no light could be fitted: {}",
+            segmentation.streaks.len(),
+            skipped
+                .iter()
+                .map(|s: &SkippedStreak| format!("streak {}: {}", s.streak, s.reason))
+                .collect::<Vec<_>>()
+                .join("; ")
+        )
+    };
+    if nothing_found {
+        warnings.push(nothing_message.clone());
+    }
+
+    let mut light_reports: Vec<LightReport> = lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| light_report(&scene, l, light_name(i)))
+        .collect();
+    let write = !nothing_found || options.allow_empty;
+    if write {
+        let to_write: Vec<LightToWrite> = lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| light_to_write(&scene, l, light_name(i)))
+            .collect();
+        let summary = clock.time("write scene", || {
+            scene_out::write_lit_scene(
+                &options.scene,
+                &options.output,
+                &to_write,
+                &WriteOptions {
+                    fallback_quads: options.fallback_quads,
+                    nits_scale: options.load.nits_scale,
+                },
+            )
+        })?;
+        for (k, r) in light_reports.iter_mut().enumerate() {
+            r.light_index = summary.light_indices.get(k).copied();
+            r.node_index = summary.node_indices.get(k).copied();
+        }
+    }
+    if let Some(dir) = &options.debug_dir {
+        clock.time("debug pictures", || {
+            write_debug(dir, &scene, &photo, &water, &segmentation, &lights, options)
+        })?;
+    }
+    let report = Report {
+        report_version: REPORT_VERSION,
+        tool_version: env!("CARGO_PKG_VERSION").into(),
+        files: Files {
+            scene: options.scene.display().to_string(),
+            photo: options.photo.display().to_string(),
+            output: write.then(|| options.output.display().to_string()),
+        },
+        settings: Settings {
+            gloss: scene.water.gloss,
+            gloss_source: scene.water.gloss_source.clone(),
+            ior: scene.water.ior,
+            shadowing: match options.shadowing {
+                Shadowing::None => "none".into(),
+                Shadowing::Smith => "smith".into(),
+            },
+            samples: options.samples,
+            seed: options.seed,
+            exposure: options.exposure,
+            nits_scale: options.load.nits_scale,
+            method: "paper".into(),
+            camera: scene.camera.name.clone(),
+            water: scene.water.name.clone(),
+        },
+        lights: light_reports,
+        skipped_streaks: skipped,
+        timings: clock.0,
+        warnings,
+    };
+    if let Some(path) = &options.report {
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::output(path, e.to_string()))?;
+        output_file::write_atomically(path, text.as_bytes())?;
+    }
+    if nothing_found && !options.allow_empty {
+        return Err(Error::NothingFound(format!(
+            "{nothing_message}; nothing was written (pass --allow-empty to write the scene anyway)"
+        )));
+    }
+    Ok(ConvertOutcome { report, lights })
+}
+
+/// Writes the `segment` pictures and, side by side, the photo, the water re-rendered with the
+/// fitted lights, and their difference.
+fn write_debug(
+    dir: &Path,
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    segmentation: &Segmentation,
+    lights: &[FittedLight],
+    options: &ConvertOptions,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    streaks::pictures::write_pictures(dir, photo, water, segmentation)?;
+    streaks::report::write_report(
+        &dir.join("streaks.json"),
+        segmentation,
+        &options.streak_params,
+    )?;
+    let area: Vec<AreaLight> = lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| area_light(l, light_name(i)))
+        .collect();
+    let rendered = render::render_with_lights(
+        scene,
+        &area,
+        &render::RenderOptions {
+            width: photo.width,
+            height: photo.height,
+            samples_per_pixel: 64,
+            exposure: options.exposure,
+            seed: options.seed,
+            shadowing: options.shadowing,
+            progress: false,
+        },
+    )?;
+    let (w, h) = (photo.width as usize, photo.height as usize);
+    let mut side_by_side = vec![[0f32; 3]; 3 * w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            // Only the water is modelled; elsewhere the re-render is black by design.
+            let photo_value = photo.radiance[i].map(|c| c * options.exposure);
+            let model = if water[i] {
+                rendered.pixels[i]
+            } else {
+                [0.0; 3]
+            };
+            let diff = if water[i] {
+                [0, 1, 2].map(|c| (photo_value[c] - model[c]).abs())
+            } else {
+                [0.0; 3]
+            };
+            side_by_side[y * 3 * w + x] = photo_value;
+            side_by_side[y * 3 * w + w + x] = model;
+            side_by_side[y * 3 * w + 2 * w + x] = diff;
+        }
+    }
+    photo_out::write(
+        &dir.join("fit-photo-render-difference.png"),
+        3 * photo.width,
+        photo.height,
+        &side_by_side,
+    )
+}
+
+/// The world-space corner of a light for messages.
+pub fn describe(light: &FittedLight, origin: DVec3) -> String {
+    let c = light.corner_left_bottom_world(origin);
+    format!(
+        "corner ({:.4}, {:.4}, {:.4}), {:.4} x {:.4}, radiance ({:.3}, {:.3}, {:.3})",
+        c.x,
+        c.y,
+        c.z,
+        light.width(),
+        light.height(),
+        light.radiance[0],
+        light.radiance[1],
+        light.radiance[2]
+    )
+}

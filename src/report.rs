@@ -1,0 +1,154 @@
+//! The machine-readable report of a fit (`--report`), described by `schema/report.schema.json`.
+
+use serde::Serialize;
+
+/// Version of the report's shape; bumped when a field changes meaning.
+pub const REPORT_VERSION: u32 = 1;
+
+/// Everything a pipeline needs to know about one run of `fit`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Version of this shape.
+    pub report_version: u32,
+    /// streaklight's version.
+    pub tool_version: String,
+    /// The input scene, photo, and the output scene.
+    pub files: Files,
+    /// The model and sampling settings used.
+    pub settings: Settings,
+    /// One entry per light written.
+    pub lights: Vec<LightReport>,
+    /// Streaks that gave no light, and why.
+    pub skipped_streaks: Vec<SkippedStreak>,
+    /// Seconds per stage, in pipeline order.
+    pub timings: Vec<Timing>,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+}
+
+/// Paths of the files involved.
+#[derive(Clone, Debug, Serialize)]
+pub struct Files {
+    /// Input scene.
+    pub scene: String,
+    /// Input photo.
+    pub photo: String,
+    /// Output scene (absent when nothing was written).
+    pub output: Option<String>,
+}
+
+/// The model and sampling settings.
+#[derive(Clone, Debug, Serialize)]
+pub struct Settings {
+    /// Blinn-Phong gloss e.
+    pub gloss: f32,
+    /// Where the gloss came from ("--gloss", "material roughness 0.25", ...).
+    pub gloss_source: String,
+    /// Index of refraction of the water.
+    pub ior: f32,
+    /// Shadowing term: "none" (G = 1, capped at grazing) or "smith".
+    pub shadowing: String,
+    /// Lobe samples per pixel.
+    pub samples: u32,
+    /// Seed of every random number.
+    pub seed: u64,
+    /// Divisor applied to the photo's linear values.
+    pub exposure: f32,
+    /// Intensity units per unit of radiance in the written lights.
+    pub nits_scale: f64,
+    /// Fitting method.
+    pub method: String,
+    /// Camera node used.
+    pub camera: String,
+    /// Water node used.
+    pub water: String,
+}
+
+/// One fitted light.
+#[derive(Clone, Debug, Serialize)]
+pub struct LightReport {
+    /// Name written into the scene.
+    pub name: String,
+    /// Streaks (ids in streaks.json) that this light explains.
+    pub streak_ids: Vec<usize>,
+    /// The plane the light sits on.
+    pub plane: PlaneReport,
+    /// Centre, world coordinates.
+    pub center: [f64; 3],
+    /// Left-bottom corner, world coordinates.
+    pub corner_left_bottom: [f64; 3],
+    /// Unit axis along the width (horizontal).
+    pub u_axis: [f64; 3],
+    /// Unit axis along the height (up on a wall).
+    pub v_axis: [f64; 3],
+    /// Width along u, metres.
+    pub width: f64,
+    /// Height along v, metres.
+    pub height: f64,
+    /// Linear RGB radiance.
+    pub radiance: [f64; 3],
+    /// Status of each edge of the light.
+    pub edges: EdgesReport,
+    /// Index of the light in the output's `EXT_lights_area.lights`.
+    pub light_index: Option<usize>,
+    /// Index of the light's node in the output.
+    pub node_index: Option<usize>,
+}
+
+/// The plane a light sits on.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlaneReport {
+    /// Index of the node whose mesh holds the plane.
+    pub node: usize,
+    /// That node's name, if it has one.
+    pub node_name: Option<String>,
+    /// A point of the plane, world coordinates.
+    pub point: [f64; 3],
+    /// Unit normal, pointing towards the water.
+    pub normal: [f64; 3],
+    /// Fraction of the brightest pixel's lobe rays that hit this plane.
+    pub hit_fraction: f64,
+}
+
+/// Per-edge status.
+#[derive(Clone, Debug, Serialize)]
+pub struct EdgesReport {
+    /// Left edge (min u).
+    pub left: EdgeReport,
+    /// Right edge (max u).
+    pub right: EdgeReport,
+    /// Bottom edge (min v).
+    pub bottom: EdgeReport,
+    /// Top edge (max v).
+    pub top: EdgeReport,
+}
+
+/// One edge's status.
+#[derive(Clone, Debug, Serialize)]
+pub struct EdgeReport {
+    /// "constrained" (measured from streak-edge pixels) or "unconstrained" (the streak's side
+    /// touches the photo's border or the water's end: the value is a guess).
+    pub status: String,
+    /// Streak-edge pixels that constrained it.
+    pub pixels: usize,
+    /// Why it is unconstrained, if it is.
+    pub reason: Option<String>,
+}
+
+/// A streak that gave no light.
+#[derive(Clone, Debug, Serialize)]
+pub struct SkippedStreak {
+    /// Streak id.
+    pub streak: usize,
+    /// Why.
+    pub reason: String,
+}
+
+/// Time spent in one stage.
+#[derive(Clone, Debug, Serialize)]
+pub struct Timing {
+    /// Stage name.
+    pub stage: String,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}

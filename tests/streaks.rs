@@ -1,0 +1,278 @@
+//! Streak extraction (METHOD §5 steps 3-6) on the sample photos of the paper's setup.
+//!
+//! The water mask comes from the sample scene (written into a temporary folder, since its
+//! water mesh is generated, not committed). Where a light's reflection falls is worked out from
+//! geometry: the mirror image of the light in the water plane y = 0, projected by the camera.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use glam::{DVec3, Vec3};
+use streaklight::photo_in::{self, Photo};
+use streaklight::random::Rng;
+use streaklight::samples::{self, SampleLight};
+use streaklight::scene_in::{self, LoadOptions, Scene};
+use streaklight::streaks::{extract_streaks, BoundingBox, Segmentation, StreakParams};
+use streaklight::water_mask::water_mask;
+
+struct Setup {
+    dir: PathBuf,
+    scene: Scene,
+    water: Vec<bool>,
+}
+
+fn setup() -> &'static Setup {
+    static SETUP: OnceLock<Setup> = OnceLock::new();
+    SETUP.get_or_init(|| {
+        let dir = common::temp_dir("streaks-samples");
+        samples::write_scenes(&dir).unwrap();
+        let scene = scene_in::load(&dir.join("scene.gltf"), &LoadOptions::default()).unwrap();
+        let water = water_mask(&scene, 600, 600);
+        Setup { dir, scene, water }
+    })
+}
+
+fn sample_photo(name: &str) -> Photo {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("samples")
+        .join(name);
+    photo_in::load(&path, samples::PHOTO_EXPOSURE).unwrap()
+}
+
+fn segment(photo: &Photo) -> Segmentation {
+    extract_streaks(photo, &setup().water, &StreakParams::default()).unwrap()
+}
+
+/// The pixel box where the mirror image of `light` in the water plane appears.
+fn reflection_box(light: &SampleLight) -> BoundingBox {
+    let s = setup();
+    let (mut x0, mut y0, mut x1, mut y1) = (f32::MAX, f32::MAX, f32::MIN, f32::MIN);
+    for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+        let corner = light.corner + DVec3::new(dx * light.width, dy * light.height, 0.0);
+        let mirrored = DVec3::new(corner.x, -corner.y, corner.z) - s.scene.origin;
+        let (px, py) = s
+            .scene
+            .camera
+            .project(
+                Vec3::new(mirrored.x as f32, mirrored.y as f32, mirrored.z as f32),
+                600,
+                600,
+            )
+            .unwrap();
+        x0 = x0.min(px);
+        x1 = x1.max(px);
+        y0 = y0.min(py);
+        y1 = y1.max(py);
+    }
+    let clamp = |v: f32| v.clamp(0.0, 599.0) as u32;
+    BoundingBox {
+        x_min: clamp(x0),
+        y_min: clamp(y0),
+        x_max: clamp(x1),
+        y_max: clamp(y1),
+    }
+}
+
+fn grown(b: BoundingBox, by: u32) -> BoundingBox {
+    BoundingBox {
+        x_min: b.x_min.saturating_sub(by),
+        y_min: b.y_min.saturating_sub(by),
+        x_max: b.x_max + by,
+        y_max: b.y_max + by,
+    }
+}
+
+fn contains(b: &BoundingBox, p: (u32, u32)) -> bool {
+    (b.x_min..=b.x_max).contains(&p.0) && (b.y_min..=b.y_max).contains(&p.1)
+}
+
+/// Checks that the streaks match the lights one to one, left to right, by geometry.
+fn check_matches(seg: &Segmentation, lights: &[SampleLight]) {
+    assert_eq!(
+        seg.streaks.len(),
+        lights.len(),
+        "streak boxes: {:?}",
+        seg.streaks.iter().map(|s| s.bbox).collect::<Vec<_>>()
+    );
+    for (streak, light) in seg.streaks.iter().zip(lights) {
+        let region = reflection_box(light);
+        assert!(
+            streak.bbox.overlaps(&region),
+            "{:?} vs {region:?}",
+            streak.bbox
+        );
+        // The brightest pixel sits on the mirror image: within a few pixels across; along the
+        // streak, ripples stretch the reflection (mostly towards the horizon, where the Fresnel
+        // factor is larger), so allow 40 rows above the flat-water image.
+        let near = BoundingBox {
+            x_min: region.x_min.saturating_sub(15),
+            x_max: region.x_max + 15,
+            y_min: region.y_min.saturating_sub(40),
+            y_max: region.y_max + 15,
+        };
+        assert!(
+            contains(&near, streak.brightest),
+            "brightest {:?} outside {region:?}",
+            streak.brightest
+        );
+        // The streak is mostly inside the region, widened by the glossy spread.
+        let inside = streak
+            .pixels
+            .iter()
+            .filter(|&&p| contains(&grown(region, 60), (p % 600, p / 600)))
+            .count();
+        assert!(inside as f64 >= 0.9 * streak.pixels.len() as f64);
+        assert!(streak.pixels.len() > 1000);
+        for side in [
+            &streak.edges.left,
+            &streak.edges.right,
+            &streak.edges.top,
+            &streak.edges.bottom,
+        ] {
+            assert!(!side.is_empty());
+        }
+    }
+}
+
+#[test]
+fn table1_white_light_gives_one_streak_where_geometry_puts_it() {
+    let seg = segment(&sample_photo("table1.png"));
+    check_matches(&seg, &[samples::table1_light()]);
+    // A white light: the streak's mean colour is grey (channels within 10 %).
+    let c = seg.streaks[0].mean_colour;
+    let (max, min) = (c[0].max(c[1]).max(c[2]), c[0].min(c[1]).min(c[2]));
+    assert!(min > 0.9 * max, "{c:?}");
+}
+
+#[test]
+fn table3_yellow_lights_give_two_streaks_left_to_right() {
+    let seg = segment(&sample_photo("table3.png"));
+    let lights = samples::table3_lights();
+    check_matches(&seg, &lights);
+    assert!(seg.streaks[0].bbox.x_max < seg.streaks[1].bbox.x_min);
+    // Yellow lights (no blue): the streaks are yellow.
+    for s in &seg.streaks {
+        let c = s.mean_colour;
+        assert!(c[2] < 0.2 * c[0] && c[2] < 0.2 * c[1], "{c:?}");
+    }
+}
+
+#[test]
+fn a_photo_without_lights_gives_no_streak_and_says_why() {
+    let seg = segment(&sample_photo("dark.png"));
+    assert!(seg.streaks.is_empty());
+    let message = seg.require_streaks().unwrap_err().to_string();
+    assert!(message.contains("no streak found"), "{message}");
+    assert!(message.contains("t = 0.350"), "{message}");
+}
+
+fn with_noise(photo: &Photo, sigma: f32, seed: u64) -> Photo {
+    let mut rng = Rng::new(seed, 0x401);
+    let display = photo
+        .display
+        .iter()
+        .map(|p| {
+            p.map(|c| {
+                let v = c + sigma * rng.next_gaussian() as f32;
+                (v.clamp(0.0, 1.0) * 255.0).round() / 255.0
+            })
+        })
+        .collect();
+    Photo::from_display(photo.width, photo.height, display, samples::PHOTO_EXPOSURE)
+}
+
+#[test]
+fn noise_of_two_levels_adds_no_streak() {
+    let sigma = 2.0 / 255.0;
+    let seg = segment(&with_noise(&sample_photo("dark.png"), sigma, 1));
+    assert!(seg.streaks.is_empty());
+    let seg = segment(&with_noise(&sample_photo("table1.png"), sigma, 2));
+    check_matches(&seg, &[samples::table1_light()]);
+    let seg = segment(&with_noise(&sample_photo("table3.png"), sigma, 3));
+    check_matches(&seg, &samples::table3_lights());
+}
+
+#[test]
+fn a_mask_of_the_wrong_size_or_without_water_is_refused() {
+    let photo = sample_photo("table1.png");
+    let params = StreakParams::default();
+    assert!(extract_streaks(&photo, &[true; 10], &params).is_err());
+    let dry = vec![false; 600 * 600];
+    let e = extract_streaks(&photo, &dry, &params)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("water covers no pixel"), "{e}");
+    let mut bad = StreakParams::default();
+    bad.seeds.row_step = 0;
+    assert!(extract_streaks(&photo, &setup().water, &bad).is_err());
+}
+
+#[test]
+fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
+    let s = setup();
+    let out = common::temp_dir("segment-cli");
+    let photo = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/table3.png");
+    let scene = s.dir.join("scene.gltf");
+    let (ok, stdout, stderr) = common::run_cli(&[
+        "segment",
+        scene.to_str().unwrap(),
+        photo.to_str().unwrap(),
+        "--out-dir",
+        out.to_str().unwrap(),
+        "--exposure",
+        "0.1",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("streak 1:"), "{stdout}");
+    for name in ["superpixels.png", "seeds.png", "streaks.png", "edges.png"] {
+        let img = image::open(out.join(name)).unwrap();
+        assert_eq!((img.width(), img.height()), (600, 600));
+    }
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("streaks.json")).unwrap()).unwrap();
+    let schema_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("schema/streaks.schema.json");
+    let schema: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(schema_path).unwrap()).unwrap();
+    let validator = jsonschema::validator_for(&schema).unwrap();
+    let errors: Vec<String> = validator
+        .iter_errors(&report)
+        .map(|e| e.to_string())
+        .collect();
+    assert!(errors.is_empty(), "{errors:?}");
+    assert_eq!(report["streaks"].as_array().unwrap().len(), 2);
+    // The schema is not vacuous: a report missing a field fails it.
+    let mut broken = report.clone();
+    broken["streaks"][0].as_object_mut().unwrap().remove("bbox");
+    assert!(!validator.is_valid(&broken));
+
+    // No lights: the pictures and report are still written, and the command fails clearly.
+    let dark = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/dark.png");
+    let out_dark = common::temp_dir("segment-cli-dark");
+    let (ok, _, stderr) = common::run_cli(&[
+        "segment",
+        scene.to_str().unwrap(),
+        dark.to_str().unwrap(),
+        "--out-dir",
+        out_dark.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("dark.png") && stderr.contains("no streak found"),
+        "{stderr}"
+    );
+    assert!(out_dark.join("streaks.json").is_file());
+
+    // A bad setting is refused before any work, naming the setting.
+    let (ok, _, stderr) = common::run_cli(&[
+        "segment",
+        scene.to_str().unwrap(),
+        photo.to_str().unwrap(),
+        "--out-dir",
+        out.to_str().unwrap(),
+        "--seed-threshold",
+        "2",
+    ]);
+    assert!(!ok && stderr.contains("seed threshold"), "{stderr}");
+}
