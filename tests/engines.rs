@@ -14,6 +14,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::Mutex;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -24,6 +25,10 @@ use streaklight::scene_out::{write_lit_scene, LightToWrite, WriteOptions};
 const ENGINES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/engines");
 const INSTALL: &str =
     "install Node.js, run `npm ci --prefix tests/engines` and `apt-get install -y chromium`";
+
+/// One headless Chromium at a time: two software-rendering browsers on a 2-core machine
+/// would each take twice as long.
+static BROWSER: Mutex<()> = Mutex::new(());
 
 /// The sample wall faces +z, towards the water and the camera.
 const WALL_NORMAL: DVec3 = DVec3::Z;
@@ -69,6 +74,27 @@ fn lit_scene_and_report(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     });
     std::fs::write(&report, serde_json::to_string_pretty(&doc).unwrap()).unwrap();
     (input, output, report)
+}
+
+/// Runs `node tests/engines/SCRIPT ARGS...`; panics with its output unless it succeeds.
+fn run_node(script: &str, args: &[(&str, &Path)], dir: &Path) {
+    let mut command = Command::new("node");
+    command.arg(Path::new(ENGINES_DIR).join(script));
+    for (flag, value) in args {
+        command.arg(flag).arg(value);
+    }
+    let run = command
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run `node` ({e}): {INSTALL}"));
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    println!("{stdout}{stderr}");
+    assert!(
+        run.status.success(),
+        "{script} failed ({}); files in {}:\n{stdout}{stderr}\n(if something is missing: {INSTALL})",
+        run.status,
+        dir.display()
+    );
 }
 
 fn light_to_write(l: &SampleLight) -> LightToWrite {
@@ -125,24 +151,18 @@ fn babylon_reads_the_lights_and_lights_the_water() {
     );
 
     let started = Instant::now();
-    let run = Command::new("node")
-        .arg(Path::new(ENGINES_DIR).join("babylon_check.mjs"))
-        .args(["--gltf".as_ref(), output.as_os_str()])
-        .args(["--report".as_ref(), report.as_os_str()])
-        .args(["--screenshot".as_ref(), lit_png.as_os_str()])
-        .args(["--dark-gltf".as_ref(), input.as_os_str()])
-        .args(["--dark-screenshot".as_ref(), dark_png.as_os_str()])
-        .args(["--mask-screenshot".as_ref(), mask_png.as_os_str()])
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run `node` ({e}): {INSTALL}"));
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    println!("{stdout}{stderr}");
-    assert!(
-        run.status.success(),
-        "the Babylon.js check failed ({}); files in {}:\n{stdout}{stderr}\n(if something is missing: {INSTALL})",
-        run.status,
-        dir.display()
+    let _one_browser = BROWSER.lock().unwrap_or_else(|e| e.into_inner());
+    run_node(
+        "babylon_check.mjs",
+        &[
+            ("--gltf", &output),
+            ("--report", &report),
+            ("--screenshot", &lit_png),
+            ("--dark-gltf", &input),
+            ("--dark-screenshot", &dark_png),
+            ("--mask-screenshot", &mask_png),
+        ],
+        &dir,
     );
     println!(
         "Babylon check took {:.1} s",
@@ -198,6 +218,41 @@ fn babylon_reads_the_lights_and_lights_the_water() {
         "only {:.0}% of the water reaches 8/255 in {}",
         100.0 * lit_share,
         lit_png.display()
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 6 item 2: the three.js example's GLTFLoader plugin makes RectAreaLights that match the
+/// report, and the example page lights the water with them.
+#[test]
+fn threejs_example_plugin_makes_matching_rect_area_lights() {
+    let dir = common::temp_dir("engines-threejs");
+    let (_input, output, report) = lit_scene_and_report(&dir);
+    let shot = dir.join("threejs.png");
+    let _one_browser = BROWSER.lock().unwrap_or_else(|e| e.into_inner());
+    run_node(
+        "threejs_check.mjs",
+        &[
+            ("--gltf", &output),
+            ("--report", &report),
+            ("--screenshot", &shot),
+        ],
+        &dir,
+    );
+    // The camera looks level from just above the water, so the lower 40% of the frame is
+    // water only (compare the Babylon test's mask); the example has no other light, so any
+    // brightness there is our lights' doing (4/255: see the Babylon test).
+    let image = read_png(&shot);
+    let (w, h) = image.dimensions();
+    let water: Vec<bool> = (0..h)
+        .flat_map(|y| (0..w).map(move |_| y >= h * 6 / 10))
+        .collect();
+    let mean = mean_where(&image, &water);
+    println!("three.js: mean brightness of the lower 40% {mean:.2}/255");
+    assert!(
+        mean > 4.0,
+        "the three.js example leaves the water black (mean {mean:.2}/255 in {})",
+        shot.display()
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

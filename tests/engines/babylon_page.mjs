@@ -36,7 +36,6 @@ const waitFrames = (n) => new Promise((resolve) => {
 
 /** Loads `url` into a new scene; returns what Babylon created. */
 window.loadScene = async (url, options = {}) => {
-  engine.stopRenderLoop();
   scene?.dispose(); // one page serves several scenes: loading Babylon's modules takes seconds
   scene = new Scene(engine);
   scene.useRightHandedSystem = !!options.rightHanded;
@@ -51,8 +50,10 @@ window.loadScene = async (url, options = {}) => {
   // The LTC tables arrive asynchronously; a light is ready once they are uploaded.
   for (let i = 0; i < 200 && !scene.lights.every((l) => l._isReady()); i++) await waitFrames(1);
   console.log("ready; rendering");
-  engine.runRenderLoop(() => scene.render());
-  await waitFrames(5);
+  // Frames are rendered on demand, not in a loop: software WebGL takes a second or more per
+  // frame of this scene, and a busy loop would only slow the screenshots down.
+  scene.render();
+  scene.render();
 
   const root = scene.getMeshByName("__root__");
   const lights = scene.lights.map((light) => {
@@ -112,5 +113,5 @@ window.showOnly = async (meshName) => {
   }
   if (kept === 0) throw new Error(`node ${meshName} has no mesh`);
   await withTimeout(scene.whenReadyAsync(), 60, "the mask never became ready");
-  await waitFrames(5);
+  scene.render();
 };
