@@ -17,10 +17,7 @@ use std::process::Command;
 use std::sync::Mutex;
 use std::time::Instant;
 
-use glam::DVec3;
-use serde_json::{json, Value};
-use streaklight::samples::{self, SampleLight};
-use streaklight::scene_out::{write_lit_scene, LightToWrite, WriteOptions};
+use streaklight::samples;
 
 const ENGINES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/engines");
 const INSTALL: &str =
@@ -30,49 +27,32 @@ const INSTALL: &str =
 /// would each take twice as long.
 static BROWSER: Mutex<()> = Mutex::new(());
 
-/// The sample wall faces +z, towards the water and the camera.
-const WALL_NORMAL: DVec3 = DVec3::Z;
-
-/// Writes the sample scenes into `dir`, lights `scene.gltf` with Table 3's lights and writes a
-/// report of them; returns (input scene, lit scene, report).
+/// Writes the sample scenes into `dir` and fits `scene.gltf` to the Table 3 photo with a
+/// report; returns (input scene, lit scene, report).
 fn lit_scene_and_report(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     samples::write_scenes(dir).expect("writing the sample scenes");
     let input = dir.join("scene.gltf");
     let output = dir.join("lit.gltf");
     let report = dir.join("report.json");
-    let options = WriteOptions::default();
-    let table3 = samples::table3_lights();
-    let lights: Vec<LightToWrite> = table3.iter().map(light_to_write).collect();
-    let summary = write_lit_scene(&input, &output, &lights, &options).expect("writing the lights");
-
-    // The report's `lights` entries for the same numbers (src/report.rs, LightReport).
-    let entries: Vec<Value> = table3
-        .iter()
-        .enumerate()
-        .map(|(i, l)| {
-            json!({
-                "name": l.name,
-                "streak_ids": [],
-                "plane": { "node_name": "Wall", "point": l.corner.to_array(), "normal": WALL_NORMAL.to_array() },
-                "center": l.center().to_array(),
-                "corner_left_bottom": l.corner.to_array(),
-                "u_axis": [1.0, 0.0, 0.0],
-                "v_axis": [0.0, 1.0, 0.0],
-                "width": l.width,
-                "height": l.height,
-                "radiance": l.radiance,
-                "light_index": summary.light_indices[i],
-                "node_index": summary.node_indices[i],
-            })
-        })
-        .collect();
-    let doc = json!({
-        "report_version": streaklight::report::REPORT_VERSION,
-        "files": { "scene": input, "photo": null, "output": output },
-        "settings": { "nits_scale": options.nits_scale, "water": "Water" },
-        "lights": entries,
-    });
-    std::fs::write(&report, serde_json::to_string_pretty(&doc).unwrap()).unwrap();
+    // A real `fit` of the Table 3 sample photo: what Babylon must reproduce is what the
+    // report says, whatever the fit's accuracy.
+    let options = streaklight::convert::ConvertOptions {
+        scene: input.clone(),
+        photo: Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/table3.png"),
+        output: output.clone(),
+        report: Some(report.clone()),
+        debug_dir: None,
+        load: Default::default(),
+        exposure: samples::PHOTO_EXPOSURE,
+        samples: streaklight::fitting::DEFAULT_SAMPLES,
+        seed: 1,
+        shadowing: streaklight::optics::Shadowing::None,
+        fallback_quads: true,
+        allow_empty: false,
+        streak_params: Default::default(),
+    };
+    let outcome = streaklight::convert::convert(&options).expect("fitting the Table 3 sample");
+    assert_eq!(outcome.report.lights.len(), 2, "Table 3 has two lights");
     (input, output, report)
 }
 
@@ -95,19 +75,6 @@ fn run_node(script: &str, args: &[(&str, &Path)], dir: &Path) {
         run.status,
         dir.display()
     );
-}
-
-fn light_to_write(l: &SampleLight) -> LightToWrite {
-    LightToWrite {
-        name: l.name.clone(),
-        center: l.center(),
-        normal: WALL_NORMAL,
-        up: DVec3::Y,
-        width: l.width,
-        height: l.height,
-        radiance: l.radiance,
-        streak_id: None,
-    }
 }
 
 /// Mean of (r + g + b) / 3 over the pixels where `mask` is set, in 8-bit units.
