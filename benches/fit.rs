@@ -35,17 +35,7 @@ fn main() {
             .iter()
             .map(|t| (t.stage.clone(), t.seconds))
             .collect();
-        // Fit stages are reported inside the "fit: ..." entries; the total counts each once.
-        let total: f64 = stages
-            .iter()
-            .filter(|(s, _)| !s.starts_with("fit: "))
-            .map(|(_, t)| t)
-            .sum::<f64>()
-            + stages
-                .iter()
-                .filter(|(s, _)| s.starts_with("fit: "))
-                .map(|(_, t)| t)
-                .sum::<f64>();
+        let total: f64 = stages.iter().map(|(_, t)| t).sum();
         println!(
             "run {run}: {total:.3} s, {} lights",
             outcome.report.lights.len()
