@@ -50,7 +50,13 @@ fn run(args: &[String]) -> (bool, String) {
 /// Runs `fit` on `scene` and `photo` into `dir/out.gltf` (report `dir/report.json`) and asserts
 /// a failure whose message holds every one of `words`, with nothing written into `dir` (its
 /// listing is unchanged).
-fn expect_refusal(dir: &Path, scene: &Path, photo: &Path, extra: &[&str], words: &[&str]) -> String {
+fn expect_refusal(
+    dir: &Path,
+    scene: &Path,
+    photo: &Path,
+    extra: &[&str],
+    words: &[&str],
+) -> String {
     let out = dir.join("out.gltf");
     let report = dir.join("report.json");
     expect_refusal_to(dir, &fit_args(scene, photo, &out, &report, extra), words)
@@ -122,7 +128,13 @@ fn good_input_fits_a_light_and_validates() {
     gltf_check::assert_validator_clean(&out);
     assert_eq!(
         fit_case::listing(&dir),
-        ["out.gltf", "photo.png", "report.json", "scene.gltf"]
+        [
+            "out.gltf",
+            "out.streaklight.bin",
+            "photo.png",
+            "report.json",
+            "scene.gltf"
+        ]
     );
     // Also as .glb.
     let glb = dir.join("out.glb");
@@ -137,7 +149,13 @@ fn photo_problems_are_refused() {
     // The aspect ratio differs from the camera's (1.0) by 1.3 % (> 0.5 %).
     let wide = dir.join("wide.png");
     fit_case::uniform_png(&wide, 162, 160, 0);
-    expect_refusal(&dir, &scene, &wide, &[], &["wide.png", "aspect ratio", "camera"]);
+    expect_refusal(
+        &dir,
+        &scene,
+        &wide,
+        &[],
+        &["wide.png", "aspect ratio", "camera"],
+    );
     // Within 0.5 % passes that check (and then fails for want of streaks, see below).
     // Missing.
     expect_refusal(
@@ -150,17 +168,35 @@ fn photo_problems_are_refused() {
     // Not an image at all.
     let corrupt = dir.join("corrupt.png");
     std::fs::write(&corrupt, b"this is not a picture\n").unwrap();
-    expect_refusal(&dir, &scene, &corrupt, &[], &["corrupt.png", "not a photo format"]);
+    expect_refusal(
+        &dir,
+        &scene,
+        &corrupt,
+        &[],
+        &["corrupt.png", "not a photo format"],
+    );
     // A PNG cut in half.
     let (_, good_photo) = good_case();
     let bytes = std::fs::read(good_photo).unwrap();
     let truncated = dir.join("truncated.png");
     std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
-    expect_refusal(&dir, &scene, &truncated, &[], &["truncated.png", "cannot decode"]);
+    expect_refusal(
+        &dir,
+        &scene,
+        &truncated,
+        &[],
+        &["truncated.png", "cannot decode"],
+    );
     // Too small.
     let small = dir.join("small.png");
     fit_case::uniform_png(&small, 32, 32, 0);
-    expect_refusal(&dir, &scene, &small, &[], &["small.png", "32 x 32", "at least 64 x 64"]);
+    expect_refusal(
+        &dir,
+        &scene,
+        &small,
+        &[],
+        &["small.png", "32 x 32", "at least 64 x 64"],
+    );
     // An empty file.
     let empty = dir.join("empty.png");
     std::fs::write(&empty, b"").unwrap();
@@ -174,11 +210,16 @@ fn photos_without_streaks_are_refused_unless_allowed() {
         let photo = dir.join(name);
         fit_case::uniform_png(&photo, SIDE, SIDE, value);
         let msg = expect_refusal(&dir, &scene, &photo, &[], &["--allow-empty"]);
-        let lower = msg.to_lowercase();
-        assert!(lower.contains("streak"), "{name}: {msg}");
-        if value == 255 {
-            assert!(lower.contains("clipped"), "{name}: {msg}");
-        }
+        assert!(
+            msg.contains(name) && msg.contains("shows no streak"),
+            "{msg}"
+        );
+        let expected = if value == 255 {
+            "every water pixel is clipped"
+        } else {
+            "every water pixel has the same value"
+        };
+        assert!(msg.contains(expected), "{name}: {msg}");
     }
     // --allow-empty: success, and the scene written with nothing lost (and validator-clean).
     let out = dir.join("empty-out.gltf");
@@ -261,7 +302,13 @@ fn output_and_report_paths_are_checked_first() {
     let missing = dir.join("no-such-folder").join("out.gltf");
     let args = fit_args(&scene, &photo, &missing, &report, &[]);
     expect_refusal_to(&dir, &args, &["no-such-folder", "does not exist"]);
-    let args = fit_args(&scene, &photo, &out, &dir.join("nofolder").join("r.json"), &[]);
+    let args = fit_args(
+        &scene,
+        &photo,
+        &out,
+        &dir.join("nofolder").join("r.json"),
+        &[],
+    );
     expect_refusal_to(&dir, &args, &["nofolder", "does not exist"]);
     let args = fit_args(&scene, &photo, &photo.join("out.gltf"), &report, &[]);
     expect_refusal_to(&dir, &args, &["photo.png"]);
@@ -308,21 +355,72 @@ fn scene_problems_are_refused() {
     let (dir, _, photo) = case_dir("fit-scene");
     // NaN vertex positions (here in the wall: its first vertex).
     let nan = edited_scene(&dir, "nan.gltf", |t| {
-        let view = &t.json["bufferViews"][t.json["accessors"][3]["bufferView"].as_u64().unwrap() as usize];
+        let view =
+            &t.json["bufferViews"][t.json["accessors"][3]["bufferView"].as_u64().unwrap() as usize];
         let offset = view["byteOffset"].as_u64().unwrap() as usize;
         t.bin[offset..offset + 4].copy_from_slice(&f32::NAN.to_le_bytes());
     });
-    expect_refusal(&dir, &nan, &photo, &[], &["nan.gltf", "NaN"]);
+    // The wall's two triangles share that vertex: both are left out, so the light has nothing
+    // to hang on, and the refusal says why.
+    expect_refusal(
+        &dir,
+        &nan,
+        &photo,
+        &[],
+        &[
+            "nan.gltf",
+            "2 degenerate or non-finite (NaN",
+            "left out",
+            "add the geometry",
+        ],
+    );
+    // A NaN in one water vertex only: those triangles are left out with a warning, the rest fits.
+    let nan_water = edited_scene(&dir, "nanwater.gltf", |t| {
+        let view =
+            &t.json["bufferViews"][t.json["accessors"][0]["bufferView"].as_u64().unwrap() as usize];
+        let offset = view["byteOffset"].as_u64().unwrap() as usize;
+        t.bin[offset..offset + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    });
+    let out = dir.join("nanwater-out.gltf");
+    let (ok, stderr) = run(&fit_args(
+        &nan_water,
+        &photo,
+        &out,
+        &dir.join("nanwater.json"),
+        &[],
+    ));
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("non-finite (NaN"), "{stderr}");
+    gltf_check::assert_keeps_everything(&nan_water, &out);
+    for f in [
+        "nanwater-out.gltf",
+        "nanwater-out.streaklight.bin",
+        "nanwater.json",
+    ] {
+        std::fs::remove_file(dir.join(f)).unwrap();
+    }
     // The camera below the water surface.
     let under = edited_scene(&dir, "under.gltf", |t| {
         t.json["nodes"][0]["translation"] = json!([0.0, -0.5, 10.0]);
     });
-    expect_refusal(&dir, &under, &photo, &[], &["under.gltf", "below the water"]);
+    expect_refusal(
+        &dir,
+        &under,
+        &photo,
+        &[],
+        &["under.gltf", "below the water"],
+    );
     // An accessor that reaches past its buffer view (and buffer).
     let short = edited_scene(&dir, "short.gltf", |t| {
         t.json["accessors"][0]["count"] = json!(1_000_000);
     });
-    expect_refusal(&dir, &short, &photo, &[], &["short.gltf", "accessor"]);
+    expect_refusal(
+        &dir,
+        &short,
+        &photo,
+        &[],
+        &["short.gltf", "POSITION", "past the end"],
+    );
     // A buffer file shorter than its byteLength.
     let t = common::paper_setup(Some(fit_case::water_material()));
     let ext = dir.join("ext.gltf");
@@ -353,6 +451,8 @@ fn scene_problems_are_refused() {
 fn report_without_timings(path: &Path) -> Value {
     let mut r: Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
     r.as_object_mut().unwrap().remove("timings");
+    // The output's path differs by the run's folder.
+    r["files"].as_object_mut().unwrap().remove("output");
     r
 }
 
@@ -387,9 +487,15 @@ fn same_seed_same_bytes_whatever_the_thread_count() {
             .collect();
         outputs.push((bytes, report_without_timings(&report)));
     }
-    assert_eq!(outputs[0].0, outputs[1].0, "1 vs 2 threads: output files differ");
+    assert_eq!(
+        outputs[0].0, outputs[1].0,
+        "1 vs 2 threads: output files differ"
+    );
     assert_eq!(outputs[0].1, outputs[1].1, "1 vs 2 threads: reports differ");
-    assert_ne!(outputs[1].0, outputs[2].0, "seeds 1 and 2 gave identical outputs");
+    assert_ne!(
+        outputs[1].0, outputs[2].0,
+        "seeds 1 and 2 gave identical outputs"
+    );
     assert_ne!(outputs[1].1["lights"], outputs[2].1["lights"]);
     let _ = EXPOSURE;
 }

@@ -143,7 +143,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
     warnings.extend(tris.warnings.iter().cloned());
     if tris.dropped > 0 {
         warnings.push(format!(
-            "{} degenerate or non-finite triangles were left out",
+            "{} degenerate or non-finite (NaN or infinite vertex) triangles were left out",
             tris.dropped
         ));
     }

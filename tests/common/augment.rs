@@ -40,7 +40,8 @@ pub fn augment(original: &Value, light: bool) -> Value {
         bin.extend_from_slice(bytes);
         views.len() - 1
     };
-    let f32s = |v: &[[f32; 3]]| -> Vec<u8> { v.iter().flatten().flat_map(|c| c.to_le_bytes()).collect() };
+    let f32s =
+        |v: &[[f32; 3]]| -> Vec<u8> { v.iter().flatten().flat_map(|c| c.to_le_bytes()).collect() };
     let u32s = |v: &[u32]| -> Vec<u8> { v.iter().flat_map(|c| c.to_le_bytes()).collect() };
     let shift = |v: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
         v.into_iter()
@@ -67,7 +68,11 @@ pub fn augment(original: &Value, light: bool) -> Value {
         "data:application/octet-stream;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(&bin)
     );
-    push(&mut doc, "buffers", json!({"uri": uri, "byteLength": bin.len()}));
+    push(
+        &mut doc,
+        "buffers",
+        json!({"uri": uri, "byteLength": bin.len()}),
+    );
     let view_index: Vec<usize> = views
         .iter()
         .map(|&(offset, len, target)| {
