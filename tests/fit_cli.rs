@@ -70,6 +70,8 @@ fn expect_refusal_to(dir: &Path, args: &[String], words: &[&str]) -> String {
         .collect();
     let (ok, stderr) = run(args);
     assert!(!ok, "{args:?} should fail; stderr: {stderr}");
+    // Shown with `--nocapture`: the messages the README's "Bad input" table quotes.
+    eprintln!("refused: {}", stderr.trim_end());
     for w in words {
         assert!(
             stderr.contains(w),
@@ -263,6 +265,7 @@ fn nothing_for_the_light_to_hang_on() {
     assert!(ok, "{stderr}");
     assert!(stderr.contains("geometry"), "{stderr}");
     assert_eq!(gltf_check::load(&scene).json, gltf_check::load(&out).json);
+    gltf_check::assert_validator_clean(&out);
 }
 
 #[test]
@@ -335,6 +338,14 @@ fn read_only_output_folder_is_refused() {
     }
     perms.set_readonly(false);
     std::fs::set_permissions(&ro, perms).unwrap();
+    // Whoever runs it: an output path that is a folder cannot be written either, and the run
+    // fails only when writing, after the fit: nothing of it may be left behind (no .bin, no
+    // report, no temporary).
+    let taken = dir.join("taken.gltf");
+    std::fs::create_dir(&taken).unwrap();
+    let args = fit_args(&scene, &photo, &taken, &dir.join("report.json"), &[]);
+    expect_refusal_to(&dir, &args, &["taken.gltf"]);
+    assert!(fit_case::listing(&taken).is_empty());
 }
 
 /// The good scene with `edit` applied, as `name` in `dir`.
@@ -392,6 +403,8 @@ fn scene_problems_are_refused() {
     assert!(ok, "{stderr}");
     assert!(stderr.contains("non-finite (NaN"), "{stderr}");
     gltf_check::assert_keeps_everything(&nan_water, &out);
+    // The input's NaN is the validator's only complaint; the output adds none.
+    gltf_check::assert_no_new_problems(&nan_water, &out);
     for f in [
         "nanwater-out.gltf",
         "nanwater-out.streaklight.bin",
