@@ -324,7 +324,7 @@ fn read_only_output_folder_is_refused() {
     std::fs::create_dir(&ro).unwrap();
     let mut perms = std::fs::metadata(&ro).unwrap().permissions();
     perms.set_readonly(true);
-    std::fs::set_permissions(&ro, perms.clone()).unwrap();
+    std::fs::set_permissions(&ro, perms).unwrap();
     // Root writes into read-only folders; only test where the permission holds.
     let probe = ro.join("probe");
     if std::fs::write(&probe, b"x").is_ok() {
@@ -336,8 +336,8 @@ fn read_only_output_folder_is_refused() {
         expect_refusal_to(&dir, &args, &["ro", "out.gltf"]);
         assert!(fit_case::listing(&ro).is_empty());
     }
-    perms.set_readonly(false);
-    std::fs::set_permissions(&ro, perms).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
     // Whoever runs it: an output path that is a folder cannot be written either, and the run
     // fails only when writing, after the fit: nothing of it may be left behind (no .bin, no
     // report, no temporary).

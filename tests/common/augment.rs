@@ -33,7 +33,7 @@ pub fn augment(original: &Value, light: bool) -> Value {
     let buffer = doc["buffers"].as_array().map_or(0, Vec::len);
     let mut views: Vec<(usize, usize, u32)> = Vec::new();
     let mut add_view = |bin: &mut Vec<u8>, bytes: &[u8], target: u32| {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         views.push((bin.len(), bytes.len(), target));
