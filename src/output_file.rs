@@ -38,8 +38,15 @@ fn canonical_or_absolute(path: &Path) -> PathBuf {
     }
 }
 
-/// Refuses an output path whose folder does not exist (or is not a folder), before any work.
+/// Refuses, before any work, an output path whose folder does not exist (or is not a folder),
+/// or that is itself a folder.
 pub fn ensure_folder_exists(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::output(
+            path,
+            "this is a folder; give the path of a file to write",
+        ));
+    }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

@@ -344,8 +344,11 @@ fn read_only_output_folder_is_refused() {
     let taken = dir.join("taken.gltf");
     std::fs::create_dir(&taken).unwrap();
     let args = fit_args(&scene, &photo, &taken, &dir.join("report.json"), &[]);
-    expect_refusal_to(&dir, &args, &["taken.gltf"]);
+    expect_refusal_to(&dir, &args, &["taken.gltf", "is a folder"]);
     assert!(fit_case::listing(&taken).is_empty());
+    // A report path that is a folder: refused before the scene is written.
+    let args = fit_args(&scene, &photo, &dir.join("out.gltf"), &taken, &[]);
+    expect_refusal_to(&dir, &args, &["taken.gltf", "is a folder"]);
 }
 
 /// The good scene with `edit` applied, as `name` in `dir`.
