@@ -325,22 +325,46 @@ fn read_only_output_folder_is_refused() {
     let mut perms = std::fs::metadata(&ro).unwrap().permissions();
     perms.set_readonly(true);
     std::fs::set_permissions(&ro, perms).unwrap();
-    // Root writes into read-only folders; only test where the permission holds.
+    // Root writes into read-only folders: then run the command as user `nobody` (setpriv).
     let probe = ro.join("probe");
-    if std::fs::write(&probe, b"x").is_ok() {
-        std::fs::remove_file(&probe).unwrap();
-        eprintln!("skipped: this user can write into read-only folders");
+    let as_root = std::fs::write(&probe, b"x").is_ok();
+    let _ = std::fs::remove_file(&probe);
+    let setpriv = Path::new("/usr/bin/setpriv");
+    if as_root && !setpriv.exists() {
+        eprintln!("skipped: root, and no setpriv to run as another user");
     } else {
-        let out = ro.join("out.gltf");
-        let args = fit_args(&scene, &photo, &out, &dir.join("report.json"), &[]);
-        expect_refusal_to(&dir, &args, &["ro", "out.gltf"]);
-        assert!(fit_case::listing(&ro).is_empty());
+        let before = fit_case::listing(&dir);
+        let args = fit_args(
+            &scene,
+            &photo,
+            &ro.join("out.gltf"),
+            &dir.join("report.json"),
+            &[],
+        );
+        let bin = env!("CARGO_BIN_EXE_streaklight");
+        let mut cmd = if as_root {
+            let mut c = std::process::Command::new(setpriv);
+            c.args(["--reuid=65534", "--regid=65534", "--clear-groups", bin]);
+            c
+        } else {
+            std::process::Command::new(bin)
+        };
+        let o = cmd.args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        eprintln!("refused: {}", stderr.trim_end());
+        assert!(!o.status.success(), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(
+            stderr.contains(&format!("{}/out.", ro.display()))
+                && stderr.contains("Permission denied"),
+            "{stderr}"
+        );
+        assert!(fit_case::listing(&ro).is_empty(), "{stderr}");
+        assert_eq!(fit_case::listing(&dir), before, "{stderr}");
     }
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
-    // Whoever runs it: an output path that is a folder cannot be written either, and the run
-    // fails only when writing, after the fit: nothing of it may be left behind (no .bin, no
-    // report, no temporary).
+    // An output path that is a folder: refused before any work, nothing left behind.
     let taken = dir.join("taken.gltf");
     std::fs::create_dir(&taken).unwrap();
     let args = fit_args(&scene, &photo, &taken, &dir.join("report.json"), &[]);
