@@ -158,7 +158,11 @@ fn photo_problems_are_refused() {
         &[],
         &["wide.png", "aspect ratio", "camera"],
     );
-    // Within 0.5 % passes that check (and then fails for want of streaks, see below).
+    // Within 0.5 % (0.4 %) passes that check, and then fails for want of streaks.
+    let close = dir.join("close.png");
+    fit_case::uniform_png(&close, 250, 249, 0);
+    let msg = expect_refusal(&dir, &scene, &close, &[], &["close.png", "shows no streak"]);
+    assert!(!msg.contains("aspect"), "{msg}");
     // Missing.
     expect_refusal(
         &dir,
