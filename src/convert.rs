@@ -93,9 +93,12 @@ fn check_output(options: &ConvertOptions) -> Result<()> {
     }
     let inputs = [options.scene.as_path(), options.photo.as_path()];
     output_file::ensure_not_an_input(&options.output, &inputs)?;
+    output_file::ensure_folder_exists(&options.output)?;
     if let Some(report) = &options.report {
         output_file::ensure_not_an_input(report, &inputs)?;
         output_file::ensure_not_an_input(report, &[options.output.as_path()])?;
+        // Checked now, so a missing report folder cannot leave a scene written without it.
+        output_file::ensure_folder_exists(report)?;
     }
     Ok(())
 }
@@ -124,6 +127,33 @@ pub fn check_photo(scene: &Scene, photo: &Photo, path: &Path) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Why the photo shows no reflection when every water pixel holds the same value.
+fn uniform_water(photo: &Photo, water: &[bool]) -> Option<String> {
+    let mut seen = photo.display.iter().zip(water).filter(|(_, &w)| w);
+    let (first, _) = seen.next()?;
+    if seen.any(|(p, _)| p != first) {
+        return None;
+    }
+    let clipped = photo
+        .display
+        .iter()
+        .zip(&photo.clipped)
+        .zip(water)
+        .all(|((_, &c), &w)| !w || c);
+    let value = first.map(|c| (c * 100.0).round());
+    Some(if clipped {
+        format!(
+            "every water pixel is clipped (at the encoding's maximum, {}/{}/{} %): the photo is overexposed and shows no streak; lower the camera's exposure",
+            value[0], value[1], value[2]
+        )
+    } else {
+        format!(
+            "every water pixel has the same value ({}/{}/{} % of full scale): the photo is blank and shows no streak; is it the right photo?",
+            value[0], value[1], value[2]
+        )
+    })
 }
 
 /// The fitter's view of a streak.
@@ -261,9 +291,13 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     let segmentation = clock.time("streaks", || {
         streaks::extract_streaks(&photo, &water, &options.streak_params)
     })?;
+    // A blank photo (one value over all the water: black, grey, all clipped) shows no
+    // reflection, however the streak extraction reads it.
+    let uniform = uniform_water(&photo, &water);
     let observations: Vec<StreakObservation> = segmentation
         .streaks
         .iter()
+        .filter(|_| uniform.is_none())
         .map(|s| observation(s, photo.width))
         .collect();
     let fit_options = FitOptions {
@@ -304,15 +338,19 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         None => (Vec::new(), Vec::new()),
     };
     let nothing_found = lights.is_empty();
-    let nothing_message = if segmentation.streaks.is_empty() {
-        segmentation
+    let nothing_message = if let Some(why) = &uniform {
+        format!("{}: {why}", options.photo.display())
+    } else if segmentation.streaks.is_empty() {
+        let why = segmentation
             .require_streaks()
             .err()
             .map(|e| e.to_string())
-            .unwrap_or_else(|| "no streak found".into())
+            .unwrap_or_else(|| "no streak found".into());
+        format!("{}: {why}", options.photo.display())
     } else {
         format!(
-            "{} streak(s) found but no light could be fitted: {}",
+            "{}: {} streak(s) found but no light could be fitted: {}",
+            options.scene.display(),
             segmentation.streaks.len(),
             skipped
                 .iter()
@@ -323,6 +361,22 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     };
     if nothing_found {
         warnings.push(nothing_message.clone());
+        if !options.allow_empty {
+            // Refused: nothing is written, not even the report. The scene's own warnings
+            // (e.g. triangles left out for NaN vertices) may be the reason, so they are told.
+            let scene_warnings = if scene.warnings.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (warnings about {}: {})",
+                    options.scene.display(),
+                    scene.warnings.join("; ")
+                )
+            };
+            return Err(Error::NothingFound(format!(
+                "{nothing_message}{scene_warnings}; nothing was written (pass --allow-empty to write the scene anyway)"
+            )));
+        }
     }
 
     let mut light_reports: Vec<LightReport> = lights
@@ -330,8 +384,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         .enumerate()
         .map(|(i, l)| light_report(&scene, l, light_name(i)))
         .collect();
-    let write = !nothing_found || options.allow_empty;
-    if write {
+    {
         let to_write: Vec<LightToWrite> = lights
             .iter()
             .enumerate()
@@ -364,7 +417,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         files: Files {
             scene: options.scene.display().to_string(),
             photo: options.photo.display().to_string(),
-            output: write.then(|| options.output.display().to_string()),
+            output: Some(options.output.display().to_string()),
         },
         settings: Settings {
             gloss: scene.water.gloss,
@@ -391,11 +444,6 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| Error::output(path, e.to_string()))?;
         output_file::write_atomically(path, text.as_bytes())?;
-    }
-    if nothing_found && !options.allow_empty {
-        return Err(Error::NothingFound(format!(
-            "{nothing_message}; nothing was written (pass --allow-empty to write the scene anyway)"
-        )));
     }
     Ok(ConvertOutcome { report, lights })
 }

@@ -38,6 +38,33 @@ fn canonical_or_absolute(path: &Path) -> PathBuf {
     }
 }
 
+/// Refuses, before any work, an output path whose folder does not exist (or is not a folder),
+/// or that is itself a folder.
+pub fn ensure_folder_exists(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::output(
+            path,
+            "this is a folder; give the path of a file to write",
+        ));
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        let what = if dir.exists() {
+            "is not a folder"
+        } else {
+            "does not exist"
+        };
+        return Err(Error::output(
+            path,
+            format!("the folder {} {what}", dir.display()),
+        ));
+    }
+    Ok(())
+}
+
 /// Writes `bytes` to `path` atomically: into a temporary file in the same folder, flushed to
 /// disk, then renamed over `path`. A failure leaves no partial file behind.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {

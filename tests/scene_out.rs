@@ -4,11 +4,12 @@
 //!
 //! Needs `node` and `npm ci --prefix tests/validator` for the validator tests.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+mod common;
 
 use base64::Engine;
+use common::gltf_check::validator_problems;
 use glam::{DQuat, DVec3};
 use serde_json::{json, Value};
 use streaklight::scene_out::{
@@ -684,33 +685,6 @@ fn assert_matches_schema(output: &Path, summary: &WriteSummary) {
             &json["nodes"][n]["extras"]["streaklight"],
         );
     }
-}
-
-/// The errors and warnings (code and JSON pointer) the Khronos glTF-Validator reports.
-fn validator_problems(file: &Path) -> BTreeMap<(String, String), usize> {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/validator/validate.mjs");
-    let out = Command::new("node").arg(script).arg(file).output().unwrap_or_else(|e| {
-        panic!("cannot run `node` ({e}): install Node.js, then run `npm ci --prefix tests/validator`")
-    });
-    assert!(
-        out.status.success(),
-        "glTF-Validator on {} failed ({}): {} -- if the package is missing, run `npm ci --prefix tests/validator`",
-        file.display(),
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
-    let mut problems = BTreeMap::new();
-    for m in report["issues"]["messages"].as_array().unwrap() {
-        if m["severity"].as_u64().unwrap() <= 1 {
-            let key = (
-                m["code"].as_str().unwrap().to_string(),
-                m["pointer"].as_str().unwrap_or("").to_string(),
-            );
-            *problems.entry(key).or_insert(0) += 1;
-        }
-    }
-    problems
 }
 
 /// The output adds no validator error or warning to those of the input (for our generated

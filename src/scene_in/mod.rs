@@ -143,7 +143,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
     warnings.extend(tris.warnings.iter().cloned());
     if tris.dropped > 0 {
         warnings.push(format!(
-            "{} degenerate or non-finite triangles were left out",
+            "{} degenerate or non-finite (NaN or infinite vertex) triangles were left out",
             tris.dropped
         ));
     }
@@ -172,6 +172,18 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
             .map(|&vertices| Triangle { vertices })
             .collect::<Vec<_>>(),
     );
+    // A camera under the water sees it from below, which the reflection model does not cover.
+    if let Some(hit) = tracer.closest_hit(camera.position, glam::Vec3::Y, 0.0, f32::INFINITY) {
+        if is_water.get(hit.triangle as usize) == Some(&true) {
+            return Err(Error::scene(
+                path,
+                format!(
+                    "the camera \"{}\" is below the water surface (the water \"{}\" is {:.3} above it): the photo must be taken from above the water",
+                    camera.name, water.name, hit.t
+                ),
+            ));
+        }
+    }
     Ok(Scene {
         path: path.to_path_buf(),
         origin,

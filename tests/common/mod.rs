@@ -274,3 +274,12 @@ pub fn run_cli(args: &[&str]) -> (bool, String, String) {
 
 /// Synthetic images with known regions (SLIC tests and benchmark).
 pub mod shapes;
+
+/// Small end-to-end `fit` cases (scene, truth light, rendered photo).
+pub mod fit_case;
+
+/// Lossless and glTF-Validator checks on outputs.
+pub mod gltf_check;
+
+/// Appends a fit setup (camera, water, wall, optional light) to glTF files we did not write.
+pub mod augment;
