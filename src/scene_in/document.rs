@@ -153,6 +153,7 @@ pub fn from_bytes(bytes: &[u8], path: &Path, base: Option<&Path>) -> Result<Sour
         root.remove("extensionsRequired");
         root.remove("animations");
     }
+    check_position_accessors(&for_reading).map_err(|m| Error::scene(path, m))?;
     let root: gltf::json::Root = serde_json::from_value(for_reading)
         .map_err(|e| Error::scene(path, format!("not a valid glTF 2.0 document: {e}")))?;
     let document = gltf::Document::from_json(root).map_err(|e| {
@@ -210,6 +211,30 @@ pub fn from_bytes(bytes: &[u8], path: &Path, base: Option<&Path>) -> Result<Sour
         document,
         buffers,
     })
+}
+
+/// Checks that every primitive's POSITION names an existing accessor: `gltf-json` 1.4.1's
+/// validation indexes the accessors with it unchecked and panics (found by fuzzing).
+fn check_position_accessors(json: &Value) -> std::result::Result<(), String> {
+    let accessors = json
+        .get("accessors")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
+    let meshes = json.get("meshes").and_then(Value::as_array);
+    for (m, mesh) in meshes.into_iter().flatten().enumerate() {
+        let primitives = mesh.get("primitives").and_then(Value::as_array);
+        for (p, primitive) in primitives.into_iter().flatten().enumerate() {
+            let Some(index) = primitive.pointer("/attributes/POSITION") else {
+                continue;
+            };
+            if index.as_u64().is_none_or(|i| i >= accessors as u64) {
+                return Err(format!(
+                    "not a valid glTF 2.0 document: mesh {m} primitive {p}: POSITION refers to accessor {index}, but there are {accessors} accessors"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Reads an external buffer. Only regular files: a URI naming a device such as `/dev/zero`
