@@ -274,7 +274,10 @@ fn nodes_reached_twice_are_refused_not_multiplied() {
     // A cycle.
     let mut doc = scene(&triangle_bin(&[]));
     doc["nodes"][1]["children"] = json!([2]);
-    doc["nodes"].as_array_mut().unwrap().push(json!({"children": [1]}));
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"children": [1]}));
     assert_scene_error(&doc, "reached more than once");
     // A root listed twice.
     let mut doc = scene(&triangle_bin(&[]));
@@ -300,11 +303,20 @@ fn buffer_files_are_only_read_from_a_folder_and_only_regular_files() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Every file under tests/data/fuzz/scene_loader: inputs the fuzzer found.
+/// Every file under tests/data/fuzz/scene_loader: inputs the fuzzer found. Each panicked;
+/// now each gives an error, or a scene without the triangles that caused the panic.
 #[test]
-fn fuzzer_found_scenes_give_clean_errors() {
+fn fuzzer_found_scenes_do_not_panic() {
     for_each_file("scene_loader", |name, bytes| {
-        assert!(load_bytes(bytes).is_err(), "{name} loaded");
+        if let Ok(scene) = load_bytes(bytes) {
+            // crash-34c0...: triangles 1e30 m away overflowed the BVH builder's areas.
+            let far = scene
+                .triangles
+                .iter()
+                .flatten()
+                .map(|p| p.abs().max_element());
+            assert!(far.fold(0.0, f32::max) <= 1e7, "{name}");
+        }
     });
 }
 

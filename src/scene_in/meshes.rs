@@ -40,6 +40,9 @@ pub struct SceneTriangles {
 /// Most triangles a scene may have, over every instance and counting those left out: a few
 /// bytes of glTF can instance a mesh many times, or declare a sparse accessor of any count.
 pub const MAX_SCENE_TRIANGLES: usize = 1 << 24;
+/// Largest distance from the camera, in metres along any axis, of a triangle kept: ten
+/// thousand kilometres is past any scene this tool is for.
+pub const MAX_COORDINATE: f32 = 1.0e7;
 /// Most vertices read over every instance, for the same reason.
 pub const MAX_SCENE_VERTICES: usize = 1 << 25;
 
@@ -249,7 +252,11 @@ fn add_primitive(
             world_positions[c as usize],
         ];
         let face = (v[1] - v[0]).cross(v[2] - v[0]);
-        let finite = v.iter().all(|p| p.is_finite());
+        // Farther than MAX_COORDINATE counts as non-finite: the BVH builder's surface areas
+        // overflow on such extents and it panics (found by fuzzing).
+        let finite = v
+            .iter()
+            .all(|p| p.is_finite() && p.abs().max_element() <= MAX_COORDINATE);
         if !finite || !face.is_finite() || face.length_squared() <= 0.0 {
             out.dropped += 1;
             continue;
