@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use image::DynamicImage;
+use image::{DynamicImage, ImageDecoder};
 
 use crate::{Error, Result};
 
@@ -105,15 +105,38 @@ impl Photo {
     }
 }
 
+/// Largest width or height accepted: larger than any camera's, small enough that a corrupt
+/// header cannot make the decoder allocate without bound.
+pub const MAX_SIDE: u32 = 32_768;
+/// Most pixels accepted (2^27, about 134 megapixels): each costs some 25 bytes once decoded
+/// into a [`Photo`], so this bounds the photo to a few GiB.
+pub const MAX_PIXELS: u64 = 1 << 27;
+/// Most bytes the decoder may allocate for the image (2 GiB).
+pub const MAX_DECODE_BYTES: u64 = 2 << 30;
+
 /// Reads and decodes the photo at `path`; `exposure` divides the linear values (METHOD §2).
 pub fn load(path: &Path, exposure: f32) -> Result<Photo> {
+    check_exposure(exposure)?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    decode(&bytes, exposure, path)
+}
+
+fn check_exposure(exposure: f32) -> Result<()> {
     if !(exposure.is_finite() && exposure > 0.0) {
         return Err(Error::Usage(format!(
             "--exposure must be a positive number, not {exposure}"
         )));
     }
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+    Ok(())
+}
+
+/// Decodes a photo from the bytes of its file; `path` names it in messages. A header that
+/// declares more than [`MAX_SIDE`] pixels on a side, more than [`MAX_PIXELS`] pixels or more
+/// than [`MAX_DECODE_BYTES`] of decoded data is refused before anything that large is
+/// allocated.
+pub fn decode(bytes: &[u8], exposure: f32, path: &Path) -> Result<Photo> {
+    check_exposure(exposure)?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| Error::io(path, e))?;
     if reader.format().is_none() {
@@ -122,9 +145,43 @@ pub fn load(path: &Path, exposure: f32) -> Result<Photo> {
             "not a photo format streaklight reads (PNG, JPEG, TIFF, OpenEXR, Radiance HDR)",
         ));
     }
-    let image = reader
-        .decode()
-        .map_err(|e| Error::photo(path, format!("cannot decode the photo: {e}")))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_SIDE);
+    limits.max_image_height = Some(MAX_SIDE);
+    limits.max_alloc = Some(MAX_DECODE_BYTES);
+    reader.limits(limits);
+    let cannot = |e: image::ImageError| {
+        let message = match e {
+            image::ImageError::Limits(e) => format!(
+                "the photo is too large ({e}); streaklight reads photos of at most {MAX_SIDE} pixels on a side and {} GiB of pixel data",
+                MAX_DECODE_BYTES >> 30
+            ),
+            e => format!("cannot decode the photo: {e}"),
+        };
+        Error::photo(path, message)
+    };
+    let decoder = reader.into_decoder().map_err(cannot)?;
+    let (width, height) = decoder.dimensions();
+    let pixels = u64::from(width) * u64::from(height);
+    if width > MAX_SIDE || height > MAX_SIDE || pixels > MAX_PIXELS {
+        return Err(Error::photo(
+            path,
+            format!(
+                "the photo is too large ({width} x {height} pixels); streaklight reads photos of at most {MAX_SIDE} pixels on a side and {MAX_PIXELS} pixels in all"
+            ),
+        ));
+    }
+    if decoder.total_bytes() > MAX_DECODE_BYTES {
+        return Err(Error::photo(
+            path,
+            format!(
+                "the photo is too large ({width} x {height} pixels, {} bytes decoded); streaklight reads at most {} GiB of pixel data",
+                decoder.total_bytes(),
+                MAX_DECODE_BYTES >> 30
+            ),
+        ));
+    }
+    let image = DynamicImage::from_decoder(decoder).map_err(cannot)?;
     from_image(image, exposure).map_err(|message| Error::photo(path, message))
 }
 

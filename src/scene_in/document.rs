@@ -123,11 +123,18 @@ pub fn percent_decode(uri: &str) -> String {
 /// Reads the scene file at `path`.
 pub fn read(path: &Path) -> Result<SourceDocument> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    from_bytes(&bytes, path, Some(path.parent().unwrap_or(Path::new("."))))
+}
+
+/// Reads a scene from its bytes. `path` names the scene in messages; external buffers are
+/// resolved relative to `base`, and with `base` = `None` (bytes that come from no folder, as
+/// when fuzzing) a buffer that refers to a file is an error.
+pub fn from_bytes(bytes: &[u8], path: &Path, base: Option<&Path>) -> Result<SourceDocument> {
     let (json_bytes, bin) = if bytes.starts_with(GLB_MAGIC) {
-        let chunks = split_glb(&bytes).map_err(|m| Error::scene(path, m))?;
+        let chunks = split_glb(bytes).map_err(|m| Error::scene(path, m))?;
         (chunks.json, chunks.bin)
     } else {
-        (&bytes[..], None)
+        (bytes, None)
     };
     let json: Value = serde_json::from_slice(json_bytes).map_err(|e| {
         Error::scene(
@@ -146,6 +153,7 @@ pub fn read(path: &Path) -> Result<SourceDocument> {
         root.remove("extensionsRequired");
         root.remove("animations");
     }
+    check_position_accessors(&for_reading).map_err(|m| Error::scene(path, m))?;
     let root: gltf::json::Root = serde_json::from_value(for_reading)
         .map_err(|e| Error::scene(path, format!("not a valid glTF 2.0 document: {e}")))?;
     let document = gltf::Document::from_json(root).map_err(|e| {
@@ -157,7 +165,6 @@ pub fn read(path: &Path) -> Result<SourceDocument> {
             ),
         )
     })?;
-    let base = path.parent().unwrap_or(Path::new("."));
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let index = buffer.index();
@@ -176,10 +183,14 @@ pub fn read(path: &Path) -> Result<SourceDocument> {
                     )
                 })?,
             gltf::buffer::Source::Uri(uri) => {
-                let file = base.join(percent_decode(uri));
-                std::fs::read(&file).map_err(|e| {
-                    Error::scene(path, format!("buffer {index} ({}): {e}", file.display()))
-                })?
+                let base = base.ok_or_else(|| {
+                    Error::scene(
+                        path,
+                        format!("buffer {index} refers to the file \"{uri}\", but the scene was not read from a folder"),
+                    )
+                })?;
+                read_buffer_file(&base.join(percent_decode(uri)))
+                    .map_err(|m| Error::scene(path, format!("buffer {index} {m}")))?
             }
         };
         if data.len() < buffer.length() {
@@ -200,6 +211,40 @@ pub fn read(path: &Path) -> Result<SourceDocument> {
         document,
         buffers,
     })
+}
+
+/// Checks that every primitive's POSITION names an existing accessor: `gltf-json` 1.4.1's
+/// validation indexes the accessors with it unchecked and panics (found by fuzzing).
+fn check_position_accessors(json: &Value) -> std::result::Result<(), String> {
+    let accessors = json
+        .get("accessors")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
+    let meshes = json.get("meshes").and_then(Value::as_array);
+    for (m, mesh) in meshes.into_iter().flatten().enumerate() {
+        let primitives = mesh.get("primitives").and_then(Value::as_array);
+        for (p, primitive) in primitives.into_iter().flatten().enumerate() {
+            let Some(index) = primitive.pointer("/attributes/POSITION") else {
+                continue;
+            };
+            if index.as_u64().is_none_or(|i| i >= accessors as u64) {
+                return Err(format!(
+                    "not a valid glTF 2.0 document: mesh {m} primitive {p}: POSITION refers to accessor {index}, but there are {accessors} accessors"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Reads an external buffer. Only regular files: a URI naming a device such as `/dev/zero`
+/// would otherwise be read without end.
+fn read_buffer_file(file: &Path) -> std::result::Result<Vec<u8>, String> {
+    let what = |e: std::io::Error| format!("({}): {e}", file.display());
+    if !std::fs::metadata(file).map_err(what)?.is_file() {
+        return Err(format!("({}): not a regular file", file.display()));
+    }
+    std::fs::read(file).map_err(what)
 }
 
 fn describe_validation(e: &gltf::Error) -> String {

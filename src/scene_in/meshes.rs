@@ -33,7 +33,18 @@ pub struct SceneTriangles {
     pub dropped: usize,
     /// Primitives left out because they are not triangles, as messages.
     pub warnings: Vec<String>,
+    /// Vertices read so far, over every instance, against [`MAX_SCENE_VERTICES`].
+    pub vertices_read: usize,
 }
+
+/// Most triangles a scene may have, over every instance and counting those left out: a few
+/// bytes of glTF can instance a mesh many times, or declare a sparse accessor of any count.
+pub const MAX_SCENE_TRIANGLES: usize = 1 << 24;
+/// Largest distance from the camera, in metres along any axis, of a triangle kept: ten
+/// thousand kilometres is past any scene this tool is for.
+pub const MAX_COORDINATE: f32 = 1.0e7;
+/// Most vertices read over every instance, for the same reason.
+pub const MAX_SCENE_VERTICES: usize = 1 << 25;
 
 /// True when the node carries the marker of a fallback quad written by this tool: such quads
 /// stand in for area lights in viewers without them and must not count as geometry.
@@ -68,6 +79,7 @@ pub fn collect(
             };
             add_primitive(
                 &primitive,
+                json,
                 buffers,
                 &instance.world,
                 origin,
@@ -81,6 +93,7 @@ pub fn collect(
 
 fn add_primitive(
     primitive: &gltf::Primitive,
+    json: &Value,
     buffers: &[Vec<u8>],
     world: &DMat4,
     origin: DVec3,
@@ -112,6 +125,28 @@ fn add_primitive(
                 accessor.index()
             ));
         }
+    }
+    // The `gltf` reader trusts the accessors it reads: it panics on a byteStride smaller than
+    // an element, on an index accessor of floats, and overflows on a huge count. Check first.
+    let position = primitive
+        .get(&gltf::Semantic::Positions)
+        .ok_or_else(|| format!("{}: it has no POSITION attribute", where_()))?;
+    check_accessor(&position, Kind::Vec3F32, json, buffers)
+        .map_err(|m| format!("{}: {m}", where_()))?;
+    if let Some(normal) = primitive.get(&gltf::Semantic::Normals) {
+        check_accessor(&normal, Kind::Vec3F32, json, buffers)
+            .map_err(|m| format!("{}: {m}", where_()))?;
+    }
+    if let Some(indices) = primitive.indices() {
+        check_accessor(&indices, Kind::Index, json, buffers)
+            .map_err(|m| format!("{}: {m}", where_()))?;
+    }
+    out.vertices_read = out.vertices_read.saturating_add(position.count());
+    if out.vertices_read > MAX_SCENE_VERTICES {
+        return Err(format!(
+            "{}: the scene has more than {MAX_SCENE_VERTICES} vertices (counting every instance); streaklight does not read scenes this large",
+            where_()
+        ));
     }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let positions: Vec<[f32; 3]> = reader
@@ -167,6 +202,16 @@ fn add_primitive(
             ));
         }
     }
+    let triangle_count = match mode {
+        Mode::Triangles => indices.len() / 3,
+        _ => indices.len().saturating_sub(2),
+    };
+    if out.positions.len() + out.dropped + triangle_count > MAX_SCENE_TRIANGLES {
+        return Err(format!(
+            "{}: the scene has more than {MAX_SCENE_TRIANGLES} triangles (counting every instance); streaklight does not read scenes this large",
+            where_()
+        ));
+    }
     let world_positions: Vec<Vec3> = positions
         .iter()
         .map(|p| (world.transform_point3(DVec3::from(p.map(f64::from))) - origin).as_vec3())
@@ -207,7 +252,11 @@ fn add_primitive(
             world_positions[c as usize],
         ];
         let face = (v[1] - v[0]).cross(v[2] - v[0]);
-        let finite = v.iter().all(|p| p.is_finite());
+        // Farther than MAX_COORDINATE counts as non-finite: the BVH builder's surface areas
+        // overflow on such extents and it panics (found by fuzzing).
+        let finite = v
+            .iter()
+            .all(|p| p.is_finite() && p.abs().max_element() <= MAX_COORDINATE);
         if !finite || !face.is_finite() || face.length_squared() <= 0.0 {
             out.dropped += 1;
             continue;
@@ -230,6 +279,144 @@ fn add_primitive(
         out.positions.push(v);
         out.normals.push(n);
         out.sources.push(source);
+    }
+    Ok(())
+}
+
+/// What an accessor must hold to be read by this module.
+#[derive(Clone, Copy)]
+enum Kind {
+    /// POSITION and NORMAL: three floats.
+    Vec3F32,
+    /// Indices: unsigned integer scalars.
+    Index,
+}
+
+/// Checks what the `gltf` reader assumes of an accessor: its type, and that every element it
+/// reads lies inside its buffer view and buffer, with a stride no smaller than an element.
+fn check_accessor(
+    accessor: &gltf::Accessor,
+    kind: Kind,
+    json: &Value,
+    buffers: &[Vec<u8>],
+) -> Result<(), String> {
+    use gltf::accessor::{DataType, Dimensions};
+    let index = accessor.index();
+    let (data_type, dimensions) = (accessor.data_type(), accessor.dimensions());
+    match kind {
+        Kind::Vec3F32 if (data_type, dimensions) != (DataType::F32, Dimensions::Vec3) => {
+            return Err(format!(
+                "accessor {index} is {dimensions:?} of {data_type:?}; positions and normals must be Vec3 of F32"
+            ));
+        }
+        Kind::Index
+            if dimensions != Dimensions::Scalar
+                || !matches!(data_type, DataType::U8 | DataType::U16 | DataType::U32) =>
+        {
+            return Err(format!(
+                "accessor {index} is {dimensions:?} of {data_type:?}; indices must be unsigned integer scalars"
+            ));
+        }
+        _ => {}
+    }
+    let count = accessor.count();
+    let size = accessor.size();
+    let what = format!("accessor {index}");
+    if let Some(view) = accessor.view() {
+        check_span(&what, &view, accessor.offset(), count, size, buffers)?;
+    }
+    let Some(sparse) = accessor.sparse() else {
+        return Ok(());
+    };
+    if accessor.view().is_none() && count > MAX_SCENE_VERTICES {
+        // Without a buffer view the count is not backed by any data: bound it.
+        return Err(format!(
+            "{what} declares {count} elements with no buffer view; streaklight reads at most {MAX_SCENE_VERTICES}"
+        ));
+    }
+    let sparse_count = sparse.count();
+    if sparse_count == 0 || sparse_count > count {
+        return Err(format!(
+            "{what}: its sparse count {sparse_count} is not between 1 and its count {count}"
+        ));
+    }
+    // `Indices::index_type` panics on a float component type, which validation lets through.
+    let index_size = match json
+        .pointer(&format!("/accessors/{index}/sparse/indices/componentType"))
+        .and_then(Value::as_u64)
+    {
+        Some(5121) => 1,
+        Some(5123) => 2,
+        Some(5125) => 4,
+        other => {
+            return Err(format!(
+                "{what}: its sparse indices have component type {other:?}, not an unsigned integer"
+            ))
+        }
+    };
+    let indices = sparse.indices();
+    check_span(
+        &format!("{what}'s sparse indices"),
+        &indices.view(),
+        indices.offset(),
+        sparse_count,
+        index_size,
+        buffers,
+    )?;
+    let values = sparse.values();
+    check_span(
+        &format!("{what}'s sparse values"),
+        &values.view(),
+        values.offset(),
+        sparse_count,
+        size,
+        buffers,
+    )
+}
+
+/// Checks that `count` elements of `size` bytes from `offset` in `view` lie inside the view
+/// and the view inside its buffer, in checked arithmetic.
+fn check_span(
+    what: &str,
+    view: &gltf::buffer::View,
+    offset: usize,
+    count: usize,
+    size: usize,
+    buffers: &[Vec<u8>],
+) -> Result<(), String> {
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        return Err(format!(
+            "{what}: buffer view {} has byteStride {stride}, smaller than one element ({size} bytes)",
+            view.index()
+        ));
+    }
+    let end = count
+        .checked_sub(1)
+        .and_then(|n| n.checked_mul(stride))
+        .and_then(|n| n.checked_add(size))
+        .and_then(|n| n.checked_add(offset));
+    if end.is_none_or(|end| end > view.length()) {
+        return Err(format!(
+            "{what}: {count} elements from byte {offset} reach past the end of buffer view {} ({} bytes)",
+            view.index(),
+            view.length()
+        ));
+    }
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, Vec::len);
+    if view
+        .offset()
+        .checked_add(view.length())
+        .is_none_or(|end| end > buffer_len)
+    {
+        return Err(format!(
+            "{what}: buffer view {} (bytes {} to {} + {}) reaches past the end of buffer {} ({buffer_len} bytes)",
+            view.index(),
+            view.offset(),
+            view.offset(),
+            view.length(),
+            view.buffer().index()
+        ));
     }
     Ok(())
 }

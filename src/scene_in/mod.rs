@@ -92,8 +92,7 @@ fn check_override(value: Option<f32>, what: &str, min_exclusive: f32) -> Result<
     Ok(())
 }
 
-/// Loads the scene at `path` (`.gltf` or `.glb`).
-pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
+fn check_options(options: &LoadOptions) -> Result<()> {
     check_override(options.gloss, "--gloss", 0.0)?;
     check_override(options.ior, "--ior", 1.0)?;
     if !(options.nits_scale.is_finite() && options.nits_scale > 0.0) {
@@ -102,7 +101,34 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
             options.nits_scale
         )));
     }
-    let source = document::read(path)?;
+    Ok(())
+}
+
+/// Loads the scene at `path` (`.gltf` or `.glb`).
+pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
+    // A bad option is reported before a missing file.
+    check_options(options)?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    load_from_bytes(
+        &bytes,
+        Some(path.parent().unwrap_or(Path::new("."))),
+        path,
+        options,
+    )
+}
+
+/// Loads a scene from the bytes of a `.gltf` or `.glb` file. External buffers are read
+/// relative to `base_dir` (with `None`, a scene that refers to a file is an error: the
+/// fuzzer uses this so it never touches the file system); `path` names the scene in
+/// messages and in [`Scene::path`].
+pub fn load_from_bytes(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<Scene> {
+    check_options(options)?;
+    let source = document::from_bytes(bytes, path, base_dir)?;
     let doc = &source.document;
     let err = |m: String| Error::scene(path, m);
     let instances = nodes::world_instances(doc, &source.json).map_err(err)?;

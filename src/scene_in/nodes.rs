@@ -32,8 +32,12 @@ pub fn world_instances(doc: &gltf::Document, json: &Value) -> Result<Vec<NodeIns
         }
     };
     let mut out = Vec::new();
+    // glTF gives a node at most one parent. A node reached twice would be instanced twice,
+    // and a chain of nodes each listing the next one twice would double the count at every
+    // level: 2^256 instances from a few hundred bytes.
+    let mut seen = vec![false; doc.nodes().len()];
     for root in roots {
-        visit(root, json, DMat4::IDENTITY, 0, &mut out)?;
+        visit(root, json, DMat4::IDENTITY, 0, &mut seen, &mut out)?;
     }
     Ok(out)
 }
@@ -64,6 +68,7 @@ fn visit(
     json: &Value,
     parent: DMat4,
     depth: usize,
+    seen: &mut [bool],
     out: &mut Vec<NodeInstance>,
 ) -> Result<(), String> {
     if depth > MAX_DEPTH {
@@ -72,13 +77,23 @@ fn visit(
             node.index()
         ));
     }
+    match seen.get_mut(node.index()) {
+        Some(s) if *s => {
+            return Err(format!(
+                "node {} is reached more than once in the scene (a node may have only one parent, and no cycles)",
+                node.index()
+            ))
+        }
+        Some(s) => *s = true,
+        None => {}
+    }
     let world = parent * local_matrix(&node, json);
     out.push(NodeInstance {
         node: node.index(),
         world,
     });
     for child in node.children() {
-        visit(child, json, world, depth + 1, out)?;
+        visit(child, json, world, depth + 1, seen, out)?;
     }
     Ok(())
 }

@@ -1,0 +1,13 @@
+//! Feeds arbitrary bytes to the scene loader as a `.gltf` or `.glb` file. Any panic, overflow,
+//! out-of-memory or timeout is a bug: every input must give a scene or a clean error.
+#![no_main]
+
+use std::path::Path;
+
+use libfuzzer_sys::fuzz_target;
+use streaklight::scene_in::{load_from_bytes, LoadOptions};
+
+fuzz_target!(|data: &[u8]| {
+    // No base folder: a buffer URI naming a file is an error, so the fuzzer never reads files.
+    let _ = load_from_bytes(data, None, Path::new("fuzz.gltf"), &LoadOptions::default());
+});
