@@ -463,7 +463,7 @@ fn scene_problems_are_refused() {
         &short,
         &photo,
         &[],
-        &["short.gltf", "POSITION", "past the end"],
+        &["short.gltf", "accessor 0", "past the end"],
     );
     // A buffer file shorter than its byteLength.
     let t = common::paper_setup(Some(fit_case::water_material()));
