@@ -15,7 +15,10 @@ fn describe(outcome: &streaklight::fitting::FitOutcome, origin: glam::DVec3) {
             l.streak_ids, c.x, c.y, c.z, l.width(), l.height(), l.radiance, l.edges, l.plane.hit_fraction
         );
     }
-    eprintln!("skipped {:?} warnings {:?} timings {:?}", outcome.skipped, outcome.warnings, outcome.timings);
+    eprintln!(
+        "skipped {:?} warnings {:?} timings {:?}",
+        outcome.skipped, outcome.warnings, outcome.timings
+    );
 }
 
 #[test]

@@ -95,3 +95,40 @@ fn joint_table1_within_half_a_percent() {
 fn joint_table3_within_half_a_percent() {
     check("table3.png", &samples::table3_lights());
 }
+
+#[test]
+#[ignore]
+fn dev_from_truth() {
+    let scene = sample_scene("scene.gltf", None);
+    let photo = sample_photo("table1.png");
+    let water = water_mask(&scene, photo.width, photo.height);
+    let streaks = segment(&photo, &water, STREAK_THRESHOLD, 200);
+    let options = FitOptions::for_scene(&scene);
+    let paper = fit_paper(&scene, &photo, &water, &streaks, &options).unwrap();
+    let truth = samples::table1_light();
+    let mut start = paper.lights.clone();
+    let pl = &start[0].plane;
+    let a = pl.coords((truth.corner - scene.origin).as_vec3());
+    let b = pl.coords(
+        (truth.corner + glam::DVec3::new(truth.width, truth.height, 0.0) - scene.origin).as_vec3(),
+    );
+    start[0].u_min = a.x;
+    start[0].v_min = a.y;
+    start[0].u_max = b.x;
+    start[0].v_max = b.y;
+    start[0].radiance = [20.0; 3];
+    let mut jo = JointOptions::new(options.model, 1);
+    jo.sweeps = 0;
+    let j0 = fit_joint(&scene, &photo, &water, &streaks, &start, &jo).unwrap();
+    eprintln!(
+        "truth rect, L solved: {:?} sigma2 {:.4e}",
+        j0.lights[0].radiance, j0.residual_variance
+    );
+    jo.sweeps = 14;
+    let j = fit_joint(&scene, &photo, &water, &streaks, &start, &jo).unwrap();
+    let (e, r) = errors(&j.lights[0], &truth, scene.origin);
+    eprintln!(
+        "from truth: edges {:?} rad {r:.4} sigma2 {:.4e}",
+        e, j.residual_variance
+    );
+}

@@ -58,6 +58,9 @@ pub struct JointOptions {
     pub margin: u32,
     /// Coordinate-descent sweeps (each halves the search window).
     pub sweeps: u32,
+    /// Fit every pixel (false) or a checkerboard half of them (true): neighbouring pixels
+    /// carry nearly the same information, and the footprints are most of the cost.
+    pub checkerboard: bool,
 }
 
 impl JointOptions {
@@ -68,7 +71,8 @@ impl JointOptions {
             seed,
             model,
             margin: 6,
-            sweeps: 14,
+            sweeps: 24,
+            checkerboard: true,
         }
     }
 }
@@ -104,6 +108,8 @@ pub struct JointOutcome {
 /// Stored samples of one light's plane: per fitted pixel, a range of points and weights.
 struct PlaneSamples {
     offsets: Vec<u32>,
+    /// Per pixel, the bounding box of its samples (empty pixels: an inverted box).
+    bbox: Vec<Rect>,
     points: Vec<Vec2>,
     weights: Vec<f32>,
 }
@@ -113,16 +119,35 @@ impl PlaneSamples {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
     }
 
-    fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> f32 {
+    /// `(c, var(c))`: the coefficient and the variance of its estimate.
+    fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> (f32, f32) {
         let r = self.range(i);
-        let mut sum = 0f32;
+        let (mut sum, mut sum2) = (0f32, 0f32);
         for (p, &w) in self.points[r.clone()].iter().zip(&self.weights[r]) {
             if rect.contains(*p) {
                 sum += w;
+                sum2 += w * w;
             }
         }
-        sum * inv_samples
+        let c = sum * inv_samples;
+        (c, estimate_variance(c, sum2, inv_samples))
     }
+}
+
+/// Variance of a coefficient estimated as the mean of N sample weights (`sum2` = sum of the
+/// squared weights inside the rectangle, `inv_n` = 1/N).
+///
+/// Why it matters: the coefficients are themselves Monte Carlo estimates, and least squares
+/// with a noisy regressor is biased (sum c_hat^2 overestimates sum c^2 by the summed
+/// variance, pulling the radiance low by a percent or more at ~100 samples and pushing the
+/// edges outwards to compensate). Subtracting the estimated variance from the normal
+/// equations removes that bias.
+fn estimate_variance(c: f32, sum2: f32, inv_n: f32) -> f32 {
+    let n = 1.0 / inv_n;
+    if n < 2.0 {
+        return 0.0;
+    }
+    ((sum2 * inv_n - c * c) / (n - 1.0)).max(0.0)
 }
 
 /// The fitting problem: observed pixels and every light's stored samples.
@@ -134,7 +159,13 @@ struct Problem {
 }
 
 /// The pixels of the fitted region: the lights' streaks dilated by `margin`, water only.
-fn region(photo: &Photo, water: &[bool], streaks: &[&StreakObservation], margin: u32) -> Vec<u32> {
+fn region(
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[&StreakObservation],
+    margin: u32,
+    checkerboard: bool,
+) -> Vec<u32> {
     let (w, h) = (photo.width as i64, photo.height as i64);
     let m = margin as i64;
     let mut mark = vec![false; (w * h) as usize];
@@ -150,6 +181,7 @@ fn region(photo: &Photo, water: &[bool], streaks: &[&StreakObservation], margin:
     }
     (0..(w * h) as usize)
         .filter(|&i| mark[i] && water[i])
+        .filter(|&i| !checkerboard || (i as i64 % w + i as i64 / w) % 2 == 0)
         .map(|i| i as u32)
         .collect()
 }
@@ -196,6 +228,7 @@ fn trace_samples(
         .map(|k| {
             let mut out = PlaneSamples {
                 offsets: Vec::with_capacity(pixels.len() + 1),
+                bbox: Vec::with_capacity(pixels.len()),
                 points: Vec::new(),
                 weights: Vec::new(),
             };
@@ -207,6 +240,20 @@ fn trace_samples(
                         out.weights.push(w);
                     }
                 }
+                let first = *out.offsets.last().unwrap_or(&0) as usize;
+                let mut bb = Rect {
+                    u_min: f32::INFINITY,
+                    u_max: f32::NEG_INFINITY,
+                    v_min: f32::INFINITY,
+                    v_max: f32::NEG_INFINITY,
+                };
+                for p in &out.points[first..] {
+                    bb.u_min = bb.u_min.min(p.x);
+                    bb.u_max = bb.u_max.max(p.x);
+                    bb.v_min = bb.v_min.min(p.y);
+                    bb.v_max = bb.v_max.max(p.y);
+                }
+                out.bbox.push(bb);
                 out.offsets.push(out.points.len() as u32);
             }
             out
@@ -314,6 +361,8 @@ struct State {
     radiance: Vec<[f64; 3]>,
     /// `coef[k][i]`: light k's coefficient at fitted pixel i with the current rectangle.
     coef: Vec<Vec<f32>>,
+    /// `var[k][i]`: the variance of that estimate.
+    var: Vec<Vec<f32>>,
 }
 
 impl Problem {
@@ -321,10 +370,18 @@ impl Problem {
         self.obs.len()
     }
 
-    fn coefficients(&self, k: usize, rect: &Rect) -> Vec<f32> {
+    fn coefficients(&self, k: usize, rect: &Rect) -> (Vec<f32>, Vec<f32>) {
         (0..self.n())
+            .into_par_iter()
             .map(|i| self.planes[k].coefficient(i, rect, self.inv_samples))
-            .collect()
+            .unzip()
+    }
+
+    fn set_rect(&self, st: &mut State, k: usize, rect: Rect) {
+        st.rects[k] = rect;
+        let (c, v) = self.coefficients(k, &rect);
+        st.coef[k] = c;
+        st.var[k] = v;
     }
 
     fn model(&self, st: &State, i: usize) -> [f64; 3] {
@@ -349,7 +406,14 @@ impl Problem {
                         if self.clipped[i] && r < 0.0 {
                             0.0
                         } else {
-                            r * r
+                            // Less the part of r^2 that is the coefficients' own noise.
+                            let noise: f64 = st
+                                .radiance
+                                .iter()
+                                .enumerate()
+                                .map(|(k, l)| l[c] * l[c] * st.var[k][i] as f64)
+                                .sum();
+                            r * r - noise
                         }
                     })
                     .sum::<f64>()
@@ -366,6 +430,7 @@ impl Problem {
             for ch in 0..3 {
                 let mut ata = vec![0.0; k * k];
                 let mut atb = vec![0.0; k];
+                let mut raw_diag = vec![0.0; k];
                 for i in (0..self.n()).filter(|&i| include[i]) {
                     for a in 0..k {
                         let ca = st.coef[a][i] as f64;
@@ -376,7 +441,13 @@ impl Problem {
                         for b in 0..k {
                             ata[a * k + b] += ca * st.coef[b][i] as f64;
                         }
+                        ata[a * k + a] -= st.var[a][i] as f64;
+                        raw_diag[a] += ca * ca;
                     }
+                }
+                for a in 0..k {
+                    // As in the edge profile: never trust less than half the raw term.
+                    ata[a * k + a] = ata[a * k + a].max(0.5 * raw_diag[a]);
                 }
                 let x = nnls_normal(&ata, &atb, k);
                 for a in 0..k {
@@ -416,8 +487,10 @@ impl Problem {
         // Residual against the other lights.
         let n = self.n();
         let mut a = vec![0f64; grid];
+        let mut a_raw = vec![0f64; grid];
         let mut b = vec![[0f64; 3]; grid];
         let mut cvals = vec![0f32; grid];
+        let mut wsq = vec![0f32; grid];
         // Clipped pixels need the whole c(t) to apply their one-sided residual later.
         let mut clipped_rows: Vec<(usize, Vec<f32>)> = Vec::new();
         for i in 0..n {
@@ -425,7 +498,38 @@ impl Problem {
             if r.is_empty() {
                 continue;
             }
+            let bb = plane.bbox[i];
+            let (bmin, bmax) = match side {
+                EdgeSide::Left | EdgeSide::Right => (bb.u_min, bb.u_max),
+                EdgeSide::Bottom | EdgeSide::Top => (bb.v_min, bb.v_max),
+            };
+            let hi = lo + step * (grid - 1) as f32;
+            if (bmax < lo || bmin > hi) && !self.clipped[i] {
+                // No sample of this pixel lies in the window: its coefficient is the same at
+                // every grid point, so there is nothing to bin.
+                let c = st.coef[k][i] as f64;
+                if c != 0.0 {
+                    let var = st.var[k][i] as f64;
+                    let mut rest = [0f64; 3];
+                    for (kk, l) in st.radiance.iter().enumerate() {
+                        if kk != k {
+                            for ch in 0..3 {
+                                rest[ch] += l[ch] * st.coef[kk][i] as f64;
+                            }
+                        }
+                    }
+                    for j in 0..grid {
+                        a_raw[j] += c * c;
+                        a[j] += c * c - var;
+                        for ch in 0..3 {
+                            b[j][ch] += c * (self.obs[i][ch] as f64 - rest[ch]);
+                        }
+                    }
+                }
+                continue;
+            }
             cvals.iter_mut().for_each(|c| *c = 0.0);
+            wsq.iter_mut().for_each(|c| *c = 0.0);
             let mut any = false;
             for (p, &w) in plane.points[r.clone()].iter().zip(&plane.weights[r]) {
                 // Inside the rectangle's other three edges?
@@ -457,6 +561,7 @@ impl Problem {
                         let j = f.ceil().max(0.0);
                         if (j as usize) < grid {
                             cvals[j as usize] += w;
+                            wsq[j as usize] += w * w;
                             any = true;
                         }
                     }
@@ -465,6 +570,7 @@ impl Problem {
                         let j = f.floor();
                         if j >= 0.0 {
                             cvals[(j as usize).min(grid - 1)] += w;
+                            wsq[(j as usize).min(grid - 1)] += w * w;
                             any = true;
                         }
                     }
@@ -477,11 +583,13 @@ impl Problem {
                 EdgeSide::Right | EdgeSide::Top => {
                     for j in 1..grid {
                         cvals[j] += cvals[j - 1];
+                        wsq[j] += wsq[j - 1];
                     }
                 }
                 EdgeSide::Left | EdgeSide::Bottom => {
                     for j in (0..grid - 1).rev() {
                         cvals[j] += cvals[j + 1];
+                        wsq[j] += wsq[j + 1];
                     }
                 }
             }
@@ -500,14 +608,22 @@ impl Problem {
                 continue;
             }
             for j in 0..grid {
-                let c = (cvals[j] * self.inv_samples) as f64;
-                a[j] += c * c;
+                let cf = cvals[j] * self.inv_samples;
+                let c = cf as f64;
+                a_raw[j] += c * c;
+                a[j] += c * c - estimate_variance(cf, wsq[j], self.inv_samples) as f64;
                 for ch in 0..3 {
                     b[j][ch] += c * res[ch];
                 }
             }
         }
         // Pixels with no sample of light k contribute a constant, left out.
+        // A rectangle that catches only a few samples has a variance as large as its mean
+        // square: the corrected normal equation would divide by ~0. Keep at least half of the
+        // raw term (the bias then stays bounded, and such a rectangle is far from the optimum).
+        for j in 0..grid {
+            a[j] = a[j].max(0.5 * a_raw[j]);
+        }
         (0..grid)
             .map(|j| {
                 let l = [0, 1, 2].map(|ch| {
@@ -617,7 +733,7 @@ pub fn fit_joint(
         )));
     }
     let t0 = Instant::now();
-    let pixels = region(photo, water, &used, options.margin);
+    let pixels = region(photo, water, &used, options.margin, options.checkerboard);
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
     let stored = trace_samples(
         scene,
@@ -679,12 +795,14 @@ fn optimise(
             }
         })
         .collect();
+    let (coef, var): (Vec<Vec<f32>>, Vec<Vec<f32>>) = rects
+        .iter()
+        .enumerate()
+        .map(|(k, r)| problem.coefficients(k, r))
+        .unzip();
     let mut st = State {
-        coef: rects
-            .iter()
-            .enumerate()
-            .map(|(k, r)| problem.coefficients(k, r))
-            .collect(),
+        coef,
+        var,
         rects,
         radiance: start.iter().map(|l| l.radiance.map(f64::from)).collect(),
     };
@@ -722,22 +840,22 @@ fn optimise(
                     }
                 }
                 let t = a + best as f32 * step;
-                st.rects[k] = st.rects[k].with_edge(side, t);
-                st.coef[k] = problem.coefficients(k, &st.rects[k]);
+                let moved_rect = st.rects[k].with_edge(side, t);
+                problem.set_rect(&mut st, k, moved_rect);
                 st.radiance[k] = prof[best].1;
-                // Shrink the window around an edge that stayed, keep it where it moved far
-                // (still travelling).
-                let moved_far = (best as i64 - cur_j as i64).unsigned_abs() as usize > GRID / 4;
-                if !moved_far {
-                    windows[k][side as usize] = (half * 0.5).max(MIN_WINDOW);
-                }
+                // Shrink the window, but never below a few times the last move: an edge
+                // coupled to others (top and bottom trade against the radiance) keeps
+                // travelling for several sweeps, and a window that shrank regardless would
+                // freeze it short of the optimum.
+                let moved = (t - cur).abs();
+                windows[k][side as usize] = (half * 0.5).max(4.0 * moved).min(half).max(MIN_WINDOW);
             }
         }
         problem.solve_radiance(&mut st);
     }
     let cost = problem.cost(&st);
     let dof = (problem.n() * 3).saturating_sub(7 * k_count).max(1);
-    let sigma2 = cost / dof as f64;
+    let sigma2 = (cost / dof as f64).max(f64::MIN_POSITIVE);
     let uncertainty = (0..k_count)
         .map(|k| uncertainty(problem, &st, k, &extents, sigma2))
         .collect();

@@ -25,7 +25,9 @@ pub fn sample_scenes() -> &'static Path {
 
 /// A committed sample photo (`samples/NAME`), decoded with the samples' exposure.
 pub fn sample_photo(name: &str) -> Photo {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples").join(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("samples")
+        .join(name);
     photo_in::load(&path, samples::PHOTO_EXPOSURE).unwrap()
 }
 
@@ -46,7 +48,12 @@ pub fn lum(c: [f32; 3]) -> f32 {
 /// Streaks by thresholding: water pixels brighter than `fraction` of the brightest unclipped
 /// water pixel, 4-connected components of at least `min_pixels`, holes filled (so the edges are
 /// the streak's outer boundary, as a region-growing extraction gives), ordered left to right.
-pub fn segment(photo: &Photo, water: &[bool], fraction: f32, min_pixels: usize) -> Vec<StreakObservation> {
+pub fn segment(
+    photo: &Photo,
+    water: &[bool],
+    fraction: f32,
+    min_pixels: usize,
+) -> Vec<StreakObservation> {
     let (w, h) = (photo.width as usize, photo.height as usize);
     let peak = (0..w * h)
         .filter(|&i| water[i] && !photo.clipped[i])
@@ -94,7 +101,8 @@ pub fn segment(photo: &Photo, water: &[bool], fraction: f32, min_pixels: usize) 
         .filter(|c| c.len() >= min_pixels)
         .map(|c| {
             let filled = fill_holes(&c, w, h);
-            let mean_x = filled.iter().map(|&p| (p as usize % w) as f32).sum::<f32>() / filled.len() as f32;
+            let mean_x =
+                filled.iter().map(|&p| (p as usize % w) as f32).sum::<f32>() / filled.len() as f32;
             (mean_x, filled)
         })
         .collect();
@@ -163,7 +171,14 @@ fn fill_holes(pixels: &[u32], w: usize, h: usize) -> Vec<u32> {
 pub fn fit_photo(scene: &Scene, photo: &Photo) -> FitOutcome {
     let water = water_mask(scene, photo.width, photo.height);
     let streaks = segment(photo, &water, STREAK_THRESHOLD, 200);
-    fit_paper(scene, photo, &water, &streaks, &FitOptions::for_scene(scene)).unwrap()
+    fit_paper(
+        scene,
+        photo,
+        &water,
+        &streaks,
+        &FitOptions::for_scene(scene),
+    )
+    .unwrap()
 }
 
 /// Fraction of the brightest water pixel above which a pixel belongs to a streak.
