@@ -189,6 +189,7 @@ fn region(
 /// Traces `samples` lobe samples of every pixel once and stores, per light, those whose first
 /// hit is that light's plane (a sample landing on a face shared by several lights is stored
 /// for each).
+#[allow(clippy::too_many_arguments)]
 fn trace_samples(
     scene: &Scene,
     model: &ReflectionModel,
@@ -450,8 +451,8 @@ impl Problem {
                     ata[a * k + a] = ata[a * k + a].max(0.5 * raw_diag[a]);
                 }
                 let x = nnls_normal(&ata, &atb, k);
-                for a in 0..k {
-                    st.radiance[a][ch] = x[a];
+                for (l, xa) in st.radiance.iter_mut().zip(&x) {
+                    l[ch] = *xa;
                 }
             }
             let mut changed = false;
