@@ -71,7 +71,7 @@ impl JointOptions {
             seed,
             model,
             margin: 6,
-            sweeps: 24,
+            sweeps: 14,
             checkerboard: true,
         }
     }
