@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use streaklight::convert::{convert, ConvertOptions};
+use streaklight::convert::{convert, ConvertOptions, Method};
 use streaklight::optics::Shadowing;
 use streaklight::samples;
 use streaklight::scene_in::LoadOptions;
@@ -19,7 +19,7 @@ struct Case {
     paper: &'static str,
 }
 
-fn options(dir: &Path, case: &Case) -> ConvertOptions {
+fn options(dir: &Path, case: &Case, method: Method) -> ConvertOptions {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     ConvertOptions {
         scene: dir.join(case.scene),
@@ -38,6 +38,7 @@ fn options(dir: &Path, case: &Case) -> ConvertOptions {
         fallback_quads: true,
         allow_empty: false,
         streak_params: Default::default(),
+        method,
     }
 }
 
@@ -100,10 +101,15 @@ fn main() {
             paper: "(5.0145, 1.99256, 0), 1.99571 x 2.01065, L (7.41385, 7.41385, 0.037866)",
         },
     ];
-    println!("| case | truth | paper | streaklight (paper method, ours) | unconstrained edges | fit time (s) |");
-    println!("|---|---|---|---|---|---|");
-    for case in &cases {
-        let result = convert(&options(&dir, case));
+    println!(
+        "| case | truth | paper | method | streaklight | unconstrained edges | fit time (s) |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for (case, method) in cases
+        .iter()
+        .flat_map(|c| [(c, Method::Paper), (c, Method::Joint)])
+    {
+        let result = convert(&options(&dir, case, method));
         let ours = match &result {
             Ok(outcome) => match outcome.report.lights.get(case.light) {
                 Some(l) => {

@@ -24,6 +24,7 @@ fn main() {
         fallback_quads: true,
         allow_empty: false,
         streak_params: Default::default(),
+        method: Default::default(),
     };
     println!("threads: {}", rayon::current_num_threads());
     let mut best: Option<(f64, Vec<(String, f64)>)> = None;

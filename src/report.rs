@@ -89,10 +89,29 @@ pub struct LightReport {
     pub radiance: [f64; 3],
     /// Status of each edge of the light.
     pub edges: EdgesReport,
+    /// One-sigma uncertainties of the joint fit (`None` with `--method paper`).
+    pub uncertainty: Option<UncertaintyReport>,
     /// Index of the light in the output's `EXT_lights_area.lights`.
     pub light_index: Option<usize>,
     /// Index of the light's node in the output.
     pub node_index: Option<usize>,
+}
+
+/// One-sigma uncertainties of a light's parameters, from the curvature of the joint fit's
+/// cost along each parameter with the others held (a lower bound where parameters trade
+/// against each other).
+#[derive(Clone, Debug, Serialize)]
+pub struct UncertaintyReport {
+    /// Left edge, metres (`None`: the photo does not constrain it).
+    pub left: Option<f64>,
+    /// Right edge, metres.
+    pub right: Option<f64>,
+    /// Bottom edge, metres.
+    pub bottom: Option<f64>,
+    /// Top edge, metres.
+    pub top: Option<f64>,
+    /// Radiance per channel.
+    pub radiance: [f64; 3],
 }
 
 /// The plane a light sits on.

@@ -50,6 +50,7 @@ fn lit_scene_and_report(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
         fallback_quads: true,
         allow_empty: false,
         streak_params: Default::default(),
+        method: Default::default(),
     };
     let outcome = streaklight::convert::convert(&options).expect("fitting the Table 3 sample");
     assert_eq!(outcome.report.lights.len(), 2, "Table 3 has two lights");

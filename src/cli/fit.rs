@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use streaklight::convert::{convert, describe, ConvertOptions};
+use streaklight::convert::{convert, describe, ConvertOptions, Method};
 use streaklight::optics::Shadowing;
 use streaklight::scene_in::LoadOptions;
 
@@ -53,6 +53,11 @@ pub struct Args {
     /// Use Smith shadowing in the reflection model (default: the paper's G = 1).
     #[arg(long)]
     pub smith: bool,
+    /// How to fit: "paper" (the paper's per-streak estimate, corrected) or "joint" (that
+    /// estimate refined by fitting all lights together to every water pixel near the streaks,
+    /// with per-parameter uncertainties in the report; slower, experimental).
+    #[arg(long, default_value = "paper", value_parser = ["joint", "paper"])]
+    pub method: String,
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]
     pub allow_empty: bool,
@@ -84,6 +89,11 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         fallback_quads: !args.no_fallback_quads,
         allow_empty: args.allow_empty,
         streak_params: Default::default(),
+        method: if args.method == "paper" {
+            Method::Paper
+        } else {
+            Method::Joint
+        },
     };
     let outcome = convert(&options)?;
     for w in &outcome.report.warnings {

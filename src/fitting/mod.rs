@@ -19,6 +19,7 @@
 pub mod edges;
 pub mod footprint;
 pub mod fragments;
+pub mod joint;
 pub mod light_plane;
 pub mod observation;
 pub mod radiance;

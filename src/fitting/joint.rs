@@ -1,0 +1,984 @@
+//! Joint refinement of all lights by render and compare (METHOD §5, last paragraph; issue 5).
+//!
+//! The paper fits each streak alone from its edge pixels. Here every water pixel near any
+//! streak counts, and all lights are fitted together: minimise
+//!
+//! ```text
+//! S = sum_p sum_c (I_c(p) - sum_k L_k,c c_k(p; rect_k))^2
+//! ```
+//!
+//! where a clipped pixel only counts when the model is below it (it is a lower bound,
+//! METHOD §2). Each pixel's coefficient is integrated over its footprint exactly as the
+//! renderer samples it (jittered camera ray, one lobe sample each). The samples of every pixel
+//! that land on each light's plane are traced ONCE; afterwards `c_k(p; rect)` for any rectangle
+//! is a sum over stored samples, so the optimisation traces no ray. The stored samples are
+//! common random numbers across all parameter values, so the cost is a deterministic function
+//! of the rectangles and the search is not confused by fresh noise at each evaluation.
+//!
+//! The model is linear in the radiances: given the rectangles they are a nonnegative least
+//! squares solve per channel. The edges are found by coordinate descent where each 1D step
+//! evaluates the cost on a whole grid of edge positions in one pass over the samples
+//! (prefix sums over binned samples), with that light's radiance re-optimised in closed form at
+//! every grid point, so a far-off start (the paper's estimate can be metres off) is pulled in
+//! by a global 1D search rather than a local step. The grid then shrinks around the best
+//! position until it is finer than a millimetre.
+
+use std::time::Instant;
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::light_plane::{reflected_sample, LightPlane};
+use super::rect::Rect;
+use super::{EdgeSide, EdgeStatus, FittedLight, StreakObservation};
+use crate::optics::ReflectionModel;
+use crate::photo_in::Photo;
+use crate::random::Rng;
+use crate::render::{trace, SceneHit};
+use crate::scene_in::Scene;
+use crate::{Error, Result};
+
+/// Stream tag of the joint fit's random numbers: distinct from the renderer's (the bare pixel
+/// index), from the plane search's and from the paper fit's footprints, so the fit never
+/// reuses the photo's own noise.
+const JOINT_STREAM: u64 = 3 << 48;
+
+/// How to refine.
+#[derive(Clone, Copy, Debug)]
+pub struct JointOptions {
+    /// Lobe samples per pixel of the fitted region. The cost sums over thousands of pixels, so
+    /// far fewer than the photo's own samples suffice.
+    pub samples: u32,
+    /// Seed of the footprints' random numbers.
+    pub seed: u64,
+    /// The water's reflection model.
+    pub model: ReflectionModel,
+    /// Pixels by which each streak is dilated to give the fitted region: the dark water around
+    /// a streak is what pins its edges down.
+    pub margin: u32,
+    /// Coordinate-descent sweeps (each halves the search window).
+    pub sweeps: u32,
+    /// Fit every pixel (false) or a checkerboard half of them (true): neighbouring pixels
+    /// carry nearly the same information, and the footprints are most of the cost.
+    pub checkerboard: bool,
+}
+
+impl JointOptions {
+    /// Defaults for a model and seed.
+    pub fn new(model: ReflectionModel, seed: u64) -> Self {
+        JointOptions {
+            samples: DEFAULT_JOINT_SAMPLES,
+            seed,
+            model,
+            margin: 6,
+            sweeps: 14,
+            checkerboard: true,
+        }
+    }
+}
+
+/// Default lobe samples per pixel of the joint fit.
+pub const DEFAULT_JOINT_SAMPLES: u32 = 96;
+
+/// One-sigma uncertainties of a light's parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uncertainty {
+    /// Left, right, bottom and top edges, metres along the plane's axes (indexed by
+    /// [`EdgeSide`]). `None` when the photo does not constrain the edge (flat cost).
+    pub edges: [Option<f32>; 4],
+    /// Radiance per channel, in radiance units.
+    pub radiance: [f32; 3],
+}
+
+/// The result of a joint fit.
+#[derive(Clone, Debug)]
+pub struct JointOutcome {
+    /// The refined lights, in the order given.
+    pub lights: Vec<FittedLight>,
+    /// Their uncertainties, in the same order.
+    pub uncertainty: Vec<Uncertainty>,
+    /// Pixels in the fitted region.
+    pub pixels: usize,
+    /// Residual sum of squares per pixel and channel at the optimum (radiance units squared).
+    pub residual_variance: f64,
+    /// Wall-clock seconds: "footprints" and "optimise".
+    pub timings: Vec<(String, f64)>,
+}
+
+/// Stored samples of one light's plane: per fitted pixel, a range of points and weights.
+struct PlaneSamples {
+    offsets: Vec<u32>,
+    /// Per pixel, the bounding box of its samples (empty pixels: an inverted box).
+    bbox: Vec<Rect>,
+    points: Vec<Vec2>,
+    weights: Vec<f32>,
+}
+
+impl PlaneSamples {
+    fn range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i] as usize..self.offsets[i + 1] as usize
+    }
+
+    /// `(c, var(c))`: the coefficient and the variance of its estimate.
+    fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> (f32, f32) {
+        let r = self.range(i);
+        let (mut sum, mut sum2) = (0f32, 0f32);
+        for (p, &w) in self.points[r.clone()].iter().zip(&self.weights[r]) {
+            if rect.contains(*p) {
+                sum += w;
+                sum2 += w * w;
+            }
+        }
+        let c = sum * inv_samples;
+        (c, estimate_variance(c, sum2, inv_samples))
+    }
+}
+
+/// Variance of a coefficient estimated as the mean of N sample weights (`sum2` = sum of the
+/// squared weights inside the rectangle, `inv_n` = 1/N).
+///
+/// Why it matters: the coefficients are themselves Monte Carlo estimates, and least squares
+/// with a noisy regressor is biased (sum c_hat^2 overestimates sum c^2 by the summed
+/// variance, pulling the radiance low by a percent or more at ~100 samples and pushing the
+/// edges outwards to compensate). Subtracting the estimated variance from the normal
+/// equations removes that bias.
+fn estimate_variance(c: f32, sum2: f32, inv_n: f32) -> f32 {
+    let n = 1.0 / inv_n;
+    if n < 2.0 {
+        return 0.0;
+    }
+    ((sum2 * inv_n - c * c) / (n - 1.0)).max(0.0)
+}
+
+/// The fitting problem: observed pixels and every light's stored samples.
+struct Problem {
+    obs: Vec<[f32; 3]>,
+    clipped: Vec<bool>,
+    planes: Vec<PlaneSamples>,
+    inv_samples: f32,
+}
+
+/// The pixels of the fitted region: the lights' streaks dilated by `margin`, water only.
+fn region(
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[&StreakObservation],
+    margin: u32,
+    checkerboard: bool,
+) -> Vec<u32> {
+    let (w, h) = (photo.width as i64, photo.height as i64);
+    let m = margin as i64;
+    let mut mark = vec![false; (w * h) as usize];
+    for s in streaks {
+        for &p in &s.pixels {
+            let (x, y) = (p as i64 % w, p as i64 / w);
+            for yy in (y - m).max(0)..=(y + m).min(h - 1) {
+                for xx in (x - m).max(0)..=(x + m).min(w - 1) {
+                    mark[(yy * w + xx) as usize] = true;
+                }
+            }
+        }
+    }
+    (0..(w * h) as usize)
+        .filter(|&i| mark[i] && water[i])
+        .filter(|&i| !checkerboard || (i as i64 % w + i as i64 / w) % 2 == 0)
+        .map(|i| i as u32)
+        .collect()
+}
+
+/// Traces `samples` lobe samples of every pixel once and stores, per light, those whose first
+/// hit is that light's plane (a sample landing on a face shared by several lights is stored
+/// for each).
+#[allow(clippy::too_many_arguments)]
+fn trace_samples(
+    scene: &Scene,
+    model: &ReflectionModel,
+    planes: &[&LightPlane],
+    pixels: &[u32],
+    width: u32,
+    height: u32,
+    samples: u32,
+    seed: u64,
+) -> Vec<PlaneSamples> {
+    type Hits = Vec<(u16, Vec2, f32)>;
+    let per_pixel: Vec<Hits> = pixels
+        .par_iter()
+        .map(|&pixel| {
+            let mut rng = Rng::new(seed, JOINT_STREAM | pixel as u64);
+            let (x, y) = (pixel % width, pixel / width);
+            let mut hits = Vec::new();
+            for _ in 0..samples {
+                let Some((start, s)) =
+                    reflected_sample(scene, model, x, y, width, height, &mut rng)
+                else {
+                    continue;
+                };
+                if let SceneHit::Surface(hit) = trace(scene, &[], start, s.wi, 0.0) {
+                    let p = start + s.wi * hit.t;
+                    for (k, plane) in planes.iter().enumerate() {
+                        if plane.contains_triangle(scene, hit.triangle) {
+                            hits.push((k as u16, plane.coords(p), s.weight));
+                        }
+                    }
+                }
+            }
+            hits
+        })
+        .collect();
+    (0..planes.len())
+        .map(|k| {
+            let mut out = PlaneSamples {
+                offsets: Vec::with_capacity(pixels.len() + 1),
+                bbox: Vec::with_capacity(pixels.len()),
+                points: Vec::new(),
+                weights: Vec::new(),
+            };
+            out.offsets.push(0);
+            for hits in &per_pixel {
+                for &(kk, p, w) in hits {
+                    if kk as usize == k {
+                        out.points.push(p);
+                        out.weights.push(w);
+                    }
+                }
+                let first = *out.offsets.last().unwrap_or(&0) as usize;
+                let mut bb = Rect {
+                    u_min: f32::INFINITY,
+                    u_max: f32::NEG_INFINITY,
+                    v_min: f32::INFINITY,
+                    v_max: f32::NEG_INFINITY,
+                };
+                for p in &out.points[first..] {
+                    bb.u_min = bb.u_min.min(p.x);
+                    bb.u_max = bb.u_max.max(p.x);
+                    bb.v_min = bb.v_min.min(p.y);
+                    bb.v_max = bb.v_max.max(p.y);
+                }
+                out.bbox.push(bb);
+                out.offsets.push(out.points.len() as u32);
+            }
+            out
+        })
+        .collect()
+}
+
+/// Solves the nonnegative least squares `min |b - A x|^2, x >= 0` for a small dense system
+/// given by its normal equations (`ata` row-major n x n, `atb`), by dropping the most negative
+/// variable until none is negative (exact for the few, mostly separated lights here).
+fn nnls_normal(ata: &[f64], atb: &[f64], n: usize) -> Vec<f64> {
+    let mut active: Vec<bool> = vec![true; n];
+    loop {
+        let idx: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
+        let m = idx.len();
+        let mut x = vec![0.0; n];
+        if m == 0 {
+            return x;
+        }
+        let mut a = vec![0.0; m * m];
+        let mut b = vec![0.0; m];
+        for (r, &i) in idx.iter().enumerate() {
+            b[r] = atb[i];
+            for (c, &j) in idx.iter().enumerate() {
+                a[r * m + c] = ata[i * n + j];
+            }
+            // A light whose rectangle receives no sample has a zero row: keep it solvable.
+            a[r * m + r] += 1e-12 * (1.0 + ata[i * n + i]);
+        }
+        let sol = solve(&mut a, &mut b, m);
+        for (r, &i) in idx.iter().enumerate() {
+            x[i] = sol[r];
+        }
+        let worst = idx
+            .iter()
+            .copied()
+            .filter(|&i| x[i] < 0.0)
+            .min_by(|&a, &b| x[a].total_cmp(&x[b]));
+        match worst {
+            Some(i) => active[i] = false,
+            None => return x,
+        }
+    }
+}
+
+/// Gaussian elimination with partial pivoting (small dense systems).
+fn solve(a: &mut [f64], b: &mut [f64], n: usize) -> Vec<f64> {
+    for col in 0..n {
+        let piv = (col..n)
+            .max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
+            .unwrap_or(col);
+        if piv != col {
+            for c in 0..n {
+                a.swap(col * n + c, piv * n + c);
+            }
+            b.swap(col, piv);
+        }
+        let d = a[col * n + col];
+        if d.abs() < 1e-300 {
+            continue;
+        }
+        for r in col + 1..n {
+            let f = a[r * n + col] / d;
+            if f != 0.0 {
+                for c in col..n {
+                    a[r * n + c] -= f * a[col * n + c];
+                }
+                b[r] -= f * b[col];
+            }
+        }
+    }
+    let mut x = vec![0.0; n];
+    for r in (0..n).rev() {
+        let mut s = b[r];
+        for c in r + 1..n {
+            s -= a[r * n + c] * x[c];
+        }
+        let d = a[r * n + r];
+        x[r] = if d.abs() < 1e-300 { 0.0 } else { s / d };
+    }
+    x
+}
+
+/// Inverse of a small symmetric positive matrix (for the radiance covariance); `None` when
+/// singular.
+fn invert(m: &[f64], n: usize) -> Option<Vec<f64>> {
+    let mut inv = vec![0.0; n * n];
+    for j in 0..n {
+        let mut a = m.to_vec();
+        let mut e = vec![0.0; n];
+        e[j] = 1.0;
+        let col = solve(&mut a, &mut e, n);
+        for i in 0..n {
+            if !col[i].is_finite() {
+                return None;
+            }
+            inv[i * n + j] = col[i];
+        }
+    }
+    Some(inv)
+}
+
+struct State {
+    rects: Vec<Rect>,
+    radiance: Vec<[f64; 3]>,
+    /// `coef[k][i]`: light k's coefficient at fitted pixel i with the current rectangle.
+    coef: Vec<Vec<f32>>,
+    /// `var[k][i]`: the variance of that estimate.
+    var: Vec<Vec<f32>>,
+}
+
+impl Problem {
+    fn n(&self) -> usize {
+        self.obs.len()
+    }
+
+    fn coefficients(&self, k: usize, rect: &Rect) -> (Vec<f32>, Vec<f32>) {
+        (0..self.n())
+            .into_par_iter()
+            .map(|i| self.planes[k].coefficient(i, rect, self.inv_samples))
+            .unzip()
+    }
+
+    fn set_rect(&self, st: &mut State, k: usize, rect: Rect) {
+        st.rects[k] = rect;
+        let (c, v) = self.coefficients(k, &rect);
+        st.coef[k] = c;
+        st.var[k] = v;
+    }
+
+    fn model(&self, st: &State, i: usize) -> [f64; 3] {
+        let mut m = [0.0; 3];
+        for (k, l) in st.radiance.iter().enumerate() {
+            let c = st.coef[k][i] as f64;
+            for ch in 0..3 {
+                m[ch] += l[ch] * c;
+            }
+        }
+        m
+    }
+
+    /// Residual sum of squares (clipped pixels only where the model is below them).
+    fn cost(&self, st: &State) -> f64 {
+        (0..self.n())
+            .map(|i| {
+                let m = self.model(st, i);
+                (0..3)
+                    .map(|c| {
+                        let r = self.obs[i][c] as f64 - m[c];
+                        if self.clipped[i] && r < 0.0 {
+                            0.0
+                        } else {
+                            // Less the part of r^2 that is the coefficients' own noise.
+                            let noise: f64 = st
+                                .radiance
+                                .iter()
+                                .enumerate()
+                                .map(|(k, l)| l[c] * l[c] * st.var[k][i] as f64)
+                                .sum();
+                            r * r - noise
+                        }
+                    })
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// Re-solves every radiance given the rectangles: per channel, nonnegative least squares
+    /// over the pixels, a clipped pixel included only while the model stays below it.
+    fn solve_radiance(&self, st: &mut State) {
+        let k = st.rects.len();
+        let mut include: Vec<bool> = self.clipped.iter().map(|c| !c).collect();
+        for _round in 0..3 {
+            for ch in 0..3 {
+                let mut ata = vec![0.0; k * k];
+                let mut atb = vec![0.0; k];
+                let mut raw_diag = vec![0.0; k];
+                for i in (0..self.n()).filter(|&i| include[i]) {
+                    for a in 0..k {
+                        let ca = st.coef[a][i] as f64;
+                        if ca == 0.0 {
+                            continue;
+                        }
+                        atb[a] += ca * self.obs[i][ch] as f64;
+                        for b in 0..k {
+                            ata[a * k + b] += ca * st.coef[b][i] as f64;
+                        }
+                        ata[a * k + a] -= st.var[a][i] as f64;
+                        raw_diag[a] += ca * ca;
+                    }
+                }
+                for a in 0..k {
+                    // As in the edge profile: never trust less than half the raw term.
+                    ata[a * k + a] = ata[a * k + a].max(0.5 * raw_diag[a]);
+                }
+                let x = nnls_normal(&ata, &atb, k);
+                for (l, xa) in st.radiance.iter_mut().zip(&x) {
+                    l[ch] = *xa;
+                }
+            }
+            let mut changed = false;
+            for i in (0..self.n()).filter(|&i| self.clipped[i]) {
+                let m = self.model(st, i);
+                let below = (0..3).any(|c| m[c] < self.obs[i][c] as f64);
+                if below != include[i] {
+                    include[i] = below;
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+    }
+
+    /// The cost, as a function of one edge of light `k` on the grid `lo + j * step`
+    /// (`j < grid`), with light k's radiance re-optimised (closed form, nonnegative) at every
+    /// grid point and the other lights held. Returns per grid point (cost up to a constant,
+    /// the radiance).
+    fn edge_profile(
+        &self,
+        st: &State,
+        k: usize,
+        side: EdgeSide,
+        lo: f32,
+        step: f32,
+        grid: usize,
+    ) -> Vec<(f64, [f64; 3])> {
+        let rect = st.rects[k];
+        let plane = &self.planes[k];
+        // Residual against the other lights.
+        let n = self.n();
+        let mut a = vec![0f64; grid];
+        let mut a_raw = vec![0f64; grid];
+        let mut b = vec![[0f64; 3]; grid];
+        let mut cvals = vec![0f32; grid];
+        let mut wsq = vec![0f32; grid];
+        // Clipped pixels need the whole c(t) to apply their one-sided residual later.
+        let mut clipped_rows: Vec<(usize, Vec<f32>)> = Vec::new();
+        for i in 0..n {
+            let r = plane.range(i);
+            if r.is_empty() {
+                continue;
+            }
+            let bb = plane.bbox[i];
+            let (bmin, bmax) = match side {
+                EdgeSide::Left | EdgeSide::Right => (bb.u_min, bb.u_max),
+                EdgeSide::Bottom | EdgeSide::Top => (bb.v_min, bb.v_max),
+            };
+            let hi = lo + step * (grid - 1) as f32;
+            if (bmax < lo || bmin > hi) && !self.clipped[i] {
+                // No sample of this pixel lies in the window: its coefficient is the same at
+                // every grid point, so there is nothing to bin.
+                let c = st.coef[k][i] as f64;
+                if c != 0.0 {
+                    let var = st.var[k][i] as f64;
+                    let mut rest = [0f64; 3];
+                    for (kk, l) in st.radiance.iter().enumerate() {
+                        if kk != k {
+                            for ch in 0..3 {
+                                rest[ch] += l[ch] * st.coef[kk][i] as f64;
+                            }
+                        }
+                    }
+                    for j in 0..grid {
+                        a_raw[j] += c * c;
+                        a[j] += c * c - var;
+                        for ch in 0..3 {
+                            b[j][ch] += c * (self.obs[i][ch] as f64 - rest[ch]);
+                        }
+                    }
+                }
+                continue;
+            }
+            cvals.iter_mut().for_each(|c| *c = 0.0);
+            wsq.iter_mut().for_each(|c| *c = 0.0);
+            let mut any = false;
+            for (p, &w) in plane.points[r.clone()].iter().zip(&plane.weights[r]) {
+                // Inside the rectangle's other three edges?
+                let (coord, inside_rest) = match side {
+                    EdgeSide::Left => (
+                        p.x,
+                        p.x <= rect.u_max && p.y >= rect.v_min && p.y <= rect.v_max,
+                    ),
+                    EdgeSide::Right => (
+                        p.x,
+                        p.x >= rect.u_min && p.y >= rect.v_min && p.y <= rect.v_max,
+                    ),
+                    EdgeSide::Bottom => (
+                        p.y,
+                        p.y <= rect.v_max && p.x >= rect.u_min && p.x <= rect.u_max,
+                    ),
+                    EdgeSide::Top => (
+                        p.y,
+                        p.y >= rect.v_min && p.x >= rect.u_min && p.x <= rect.u_max,
+                    ),
+                };
+                if !inside_rest {
+                    continue;
+                }
+                let f = (coord - lo) / step;
+                match side {
+                    // A max edge at t includes the sample when t >= coord.
+                    EdgeSide::Right | EdgeSide::Top => {
+                        let j = f.ceil().max(0.0);
+                        if (j as usize) < grid {
+                            cvals[j as usize] += w;
+                            wsq[j as usize] += w * w;
+                            any = true;
+                        }
+                    }
+                    // A min edge at t includes it when t <= coord.
+                    EdgeSide::Left | EdgeSide::Bottom => {
+                        let j = f.floor();
+                        if j >= 0.0 {
+                            cvals[(j as usize).min(grid - 1)] += w;
+                            wsq[(j as usize).min(grid - 1)] += w * w;
+                            any = true;
+                        }
+                    }
+                }
+            }
+            if !any {
+                continue;
+            }
+            match side {
+                EdgeSide::Right | EdgeSide::Top => {
+                    for j in 1..grid {
+                        cvals[j] += cvals[j - 1];
+                        wsq[j] += wsq[j - 1];
+                    }
+                }
+                EdgeSide::Left | EdgeSide::Bottom => {
+                    for j in (0..grid - 1).rev() {
+                        cvals[j] += cvals[j + 1];
+                        wsq[j] += wsq[j + 1];
+                    }
+                }
+            }
+            let mut rest = [0f64; 3];
+            for (kk, l) in st.radiance.iter().enumerate() {
+                if kk != k {
+                    let c = st.coef[kk][i] as f64;
+                    for ch in 0..3 {
+                        rest[ch] += l[ch] * c;
+                    }
+                }
+            }
+            let res = [0, 1, 2].map(|ch| self.obs[i][ch] as f64 - rest[ch]);
+            if self.clipped[i] {
+                clipped_rows.push((i, cvals.iter().map(|c| c * self.inv_samples).collect()));
+                continue;
+            }
+            for j in 0..grid {
+                let cf = cvals[j] * self.inv_samples;
+                let c = cf as f64;
+                a_raw[j] += c * c;
+                a[j] += c * c - estimate_variance(cf, wsq[j], self.inv_samples) as f64;
+                for ch in 0..3 {
+                    b[j][ch] += c * res[ch];
+                }
+            }
+        }
+        // Pixels with no sample of light k contribute a constant, left out.
+        // A rectangle that catches only a few samples has a variance as large as its mean
+        // square: the corrected normal equation would divide by ~0. Keep at least half of the
+        // raw term (the bias then stays bounded, and such a rectangle is far from the optimum).
+        for j in 0..grid {
+            a[j] = a[j].max(0.5 * a_raw[j]);
+        }
+        (0..grid)
+            .map(|j| {
+                let l = [0, 1, 2].map(|ch| {
+                    if a[j] > 0.0 {
+                        (b[j][ch] / a[j]).max(0.0)
+                    } else {
+                        0.0
+                    }
+                });
+                // sum (r - L c)^2 - sum r^2 = L^2 A - 2 L B
+                let mut cost: f64 = (0..3)
+                    .map(|ch| l[ch] * l[ch] * a[j] - 2.0 * l[ch] * b[j][ch])
+                    .sum();
+                for (i, cs) in &clipped_rows {
+                    let c = cs[j] as f64;
+                    for ch in 0..3 {
+                        let rest: f64 = st
+                            .radiance
+                            .iter()
+                            .enumerate()
+                            .filter(|(kk, _)| *kk != k)
+                            .map(|(kk, lr)| lr[ch] * st.coef[kk][*i] as f64)
+                            .sum();
+                        let r = self.obs[*i][ch] as f64 - rest - l[ch] * c;
+                        let r0 = self.obs[*i][ch] as f64 - rest;
+                        let now = if r < 0.0 { 0.0 } else { r * r };
+                        let before = if r0 < 0.0 { 0.0 } else { r0 * r0 };
+                        cost += now - before;
+                    }
+                }
+                (cost, l)
+            })
+            .collect()
+    }
+}
+
+/// How far the photo could possibly move an edge: the extent of light k's stored samples.
+fn sample_extent(p: &PlaneSamples) -> Option<Rect> {
+    let mut it = p.points.iter();
+    let first = it.next()?;
+    let mut r = Rect {
+        u_min: first.x,
+        u_max: first.x,
+        v_min: first.y,
+        v_max: first.y,
+    };
+    for q in it {
+        r.u_min = r.u_min.min(q.x);
+        r.u_max = r.u_max.max(q.x);
+        r.v_min = r.v_min.min(q.y);
+        r.v_max = r.v_max.max(q.y);
+    }
+    Some(r)
+}
+
+const GRID: usize = 65;
+/// Smallest search half-window, metres: well under the 0.5 % of a metre-sized light asked for.
+const MIN_WINDOW: f32 = 2e-4;
+
+/// Refines `start` (typically the paper's per-streak estimate) by fitting all lights together
+/// to every water pixel of their streaks and surroundings (see the module doc).
+///
+/// `streaks` must hold the streaks named by the lights' `streak_ids` (their pixels, dilated,
+/// are the fitted region). The lights' planes are kept; edges and radiances are refitted.
+pub fn fit_joint(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    start: &[FittedLight],
+    options: &JointOptions,
+) -> Result<JointOutcome> {
+    let n_all = photo.width as usize * photo.height as usize;
+    if photo.radiance.len() != n_all || photo.clipped.len() != n_all || water.len() != n_all {
+        return Err(Error::Usage(format!(
+            "the photo ({} x {}) and its water mask ({} pixels) do not match",
+            photo.width,
+            photo.height,
+            water.len()
+        )));
+    }
+    if options.samples == 0 {
+        return Err(Error::Usage(
+            "the joint fit needs at least one sample per pixel".into(),
+        ));
+    }
+    if start.is_empty() {
+        return Ok(JointOutcome {
+            lights: Vec::new(),
+            uncertainty: Vec::new(),
+            pixels: 0,
+            residual_variance: 0.0,
+            timings: Vec::new(),
+        });
+    }
+    let used: Vec<&StreakObservation> = streaks
+        .iter()
+        .filter(|s| start.iter().any(|l| l.streak_ids.contains(&s.id)))
+        .collect();
+    if let Some(s) = used
+        .iter()
+        .find(|s| s.pixels.iter().any(|&p| p as usize >= n_all))
+    {
+        return Err(Error::Usage(format!(
+            "streak {} holds a pixel outside the {} x {} photo",
+            s.id, photo.width, photo.height
+        )));
+    }
+    let t0 = Instant::now();
+    let pixels = region(photo, water, &used, options.margin, options.checkerboard);
+    let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
+    let stored = trace_samples(
+        scene,
+        &options.model,
+        &planes,
+        &pixels,
+        photo.width,
+        photo.height,
+        options.samples,
+        options.seed,
+    );
+    let footprint_seconds = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let problem = Problem {
+        obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
+        clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
+        planes: stored,
+        inv_samples: 1.0 / options.samples as f32,
+    };
+    let (lights, uncertainty, variance) = optimise(&problem, start, options.sweeps);
+    Ok(JointOutcome {
+        lights,
+        uncertainty,
+        pixels: pixels.len(),
+        residual_variance: variance,
+        timings: vec![
+            ("footprints".into(), footprint_seconds),
+            ("optimise".into(), t1.elapsed().as_secs_f64()),
+        ],
+    })
+}
+
+fn optimise(
+    problem: &Problem,
+    start: &[FittedLight],
+    sweeps: u32,
+) -> (Vec<FittedLight>, Vec<Uncertainty>, f64) {
+    let k_count = start.len();
+    let extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
+    // Start rectangles, clamped into the region the samples can see (an unconstrained edge of
+    // the paper fit may sit far beyond it).
+    let rects: Vec<Rect> = start
+        .iter()
+        .zip(&extents)
+        .map(|(l, e)| {
+            let r = l.rect();
+            match e {
+                Some(e) => {
+                    let u_min = r.u_min.clamp(e.u_min, e.u_max);
+                    let v_min = r.v_min.clamp(e.v_min, e.v_max);
+                    Rect {
+                        u_min,
+                        u_max: r.u_max.clamp(u_min, e.u_max),
+                        v_min,
+                        v_max: r.v_max.clamp(v_min, e.v_max),
+                    }
+                }
+                None => r,
+            }
+        })
+        .collect();
+    let (coef, var): (Vec<Vec<f32>>, Vec<Vec<f32>>) = rects
+        .iter()
+        .enumerate()
+        .map(|(k, r)| problem.coefficients(k, r))
+        .unzip();
+    let mut st = State {
+        coef,
+        var,
+        rects,
+        radiance: start.iter().map(|l| l.radiance.map(f64::from)).collect(),
+    };
+    problem.solve_radiance(&mut st);
+    // Initial half-windows: half the light's size, at least 0.5 m, so an estimate that is a
+    // light's size off is still inside the first grid.
+    let mut windows: Vec<[f32; 4]> = st
+        .rects
+        .iter()
+        .map(|r| {
+            let s = (0.5 * r.width().max(r.height())).max(0.5);
+            [s; 4]
+        })
+        .collect();
+    for _sweep in 0..sweeps {
+        for k in 0..k_count {
+            let Some(ext) = extents[k] else { continue };
+            for side in EdgeSide::ALL {
+                let half = windows[k][side as usize];
+                let cur = st.rects[k].edge(side);
+                let (lo, hi) = edge_bounds(&st.rects[k], side, &ext);
+                let a = (cur - half).max(lo);
+                let b = (cur + half).min(hi);
+                if b <= a {
+                    continue;
+                }
+                let step = (b - a) / (GRID - 1) as f32;
+                let prof = problem.edge_profile(&st, k, side, a, step, GRID);
+                let cur_j = ((cur - a) / step).round().clamp(0.0, (GRID - 1) as f32) as usize;
+                // Prefer the current position on ties (flat cost: an unconstrained edge).
+                let mut best = cur_j;
+                for (j, p) in prof.iter().enumerate() {
+                    if p.0 < prof[best].0 - 1e-12 * prof[best].0.abs().max(1e-30) {
+                        best = j;
+                    }
+                }
+                let t = a + best as f32 * step;
+                let moved_rect = st.rects[k].with_edge(side, t);
+                problem.set_rect(&mut st, k, moved_rect);
+                st.radiance[k] = prof[best].1;
+                // Shrink the window, but never below a few times the last move: an edge
+                // coupled to others (top and bottom trade against the radiance) keeps
+                // travelling for several sweeps, and a window that shrank regardless would
+                // freeze it short of the optimum.
+                let moved = (t - cur).abs();
+                windows[k][side as usize] = (half * 0.5).max(4.0 * moved).min(half).max(MIN_WINDOW);
+            }
+        }
+        problem.solve_radiance(&mut st);
+    }
+    let cost = problem.cost(&st);
+    let dof = (problem.n() * 3).saturating_sub(7 * k_count).max(1);
+    let sigma2 = (cost / dof as f64).max(f64::MIN_POSITIVE);
+    let uncertainty = (0..k_count)
+        .map(|k| uncertainty(problem, &st, k, &extents, sigma2))
+        .collect();
+    let lights = start
+        .iter()
+        .zip(st.rects.iter().zip(&st.radiance))
+        .map(|(l, (r, rad))| FittedLight {
+            streak_ids: l.streak_ids.clone(),
+            plane: l.plane.clone(),
+            u_min: r.u_min,
+            u_max: r.u_max,
+            v_min: r.v_min,
+            v_max: r.v_max,
+            radiance: rad.map(|c| c as f32),
+            edges: l.edges.clone(),
+        })
+        .collect();
+    (lights, uncertainty, sigma2)
+}
+
+/// Where an edge may go: inside the samples' extent and not past the opposite edge.
+fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect) -> (f32, f32) {
+    let eps = 1e-3;
+    match side {
+        EdgeSide::Left => (ext.u_min - eps, r.u_max - eps),
+        EdgeSide::Right => (r.u_min + eps, ext.u_max + eps),
+        EdgeSide::Bottom => (ext.v_min - eps, r.v_max - eps),
+        EdgeSide::Top => (r.v_min + eps, ext.v_max + eps),
+    }
+}
+
+/// One-sigma uncertainties from the curvature of the cost (Gauss-Newton: var = sigma^2 / a for
+/// a cost `S0 + a (t - t0)^2` along one edge, the light's radiance re-optimised along it, the
+/// other parameters held; radiance from `sigma^2 (C^T C)^-1`).
+fn uncertainty(
+    problem: &Problem,
+    st: &State,
+    k: usize,
+    extents: &[Option<Rect>],
+    sigma2: f64,
+) -> Uncertainty {
+    let mut edges = [None; 4];
+    if let Some(ext) = extents[k] {
+        for side in EdgeSide::ALL {
+            let r = st.rects[k];
+            let cur = r.edge(side);
+            // A window of a few percent of the light: wide enough to average over the
+            // staircase of the sampled cost, narrow enough to stay quadratic.
+            let half = (0.03 * r.width().max(r.height())).max(0.01);
+            let (lo, hi) = edge_bounds(&r, side, &ext);
+            let a = (cur - half).max(lo);
+            let b = (cur + half).min(hi);
+            if b <= a {
+                continue;
+            }
+            let step = (b - a) / (GRID - 1) as f32;
+            let prof = problem.edge_profile(st, k, side, a, step, GRID);
+            // Least-squares parabola in x = t - cur.
+            let pts: Vec<(f64, f64)> = prof
+                .iter()
+                .enumerate()
+                .map(|(j, p)| ((a + j as f32 * step - cur) as f64, p.0))
+                .collect();
+            if let Some(curv) = parabola_curvature(&pts) {
+                if curv > 0.0 {
+                    edges[side as usize] = Some((sigma2 / curv).sqrt() as f32);
+                }
+            }
+        }
+    }
+    // Radiance: sigma^2 [(C^T C)^-1]_kk over the unclipped pixels.
+    let n = st.rects.len();
+    let mut ctc = vec![0.0; n * n];
+    for i in (0..problem.n()).filter(|&i| !problem.clipped[i]) {
+        for a in 0..n {
+            let ca = st.coef[a][i] as f64;
+            if ca != 0.0 {
+                for b in 0..n {
+                    ctc[a * n + b] += ca * st.coef[b][i] as f64;
+                }
+            }
+        }
+    }
+    let radiance = match invert(&ctc, n) {
+        Some(inv) if inv[k * n + k] > 0.0 => [((sigma2 * inv[k * n + k]).sqrt()) as f32; 3],
+        _ => [f32::INFINITY; 3],
+    };
+    Uncertainty { edges, radiance }
+}
+
+/// The quadratic coefficient of the least-squares parabola through `pts`.
+fn parabola_curvature(pts: &[(f64, f64)]) -> Option<f64> {
+    if pts.len() < 3 {
+        return None;
+    }
+    let mut m = [0.0f64; 9];
+    let mut rhs = [0.0f64; 3];
+    for &(x, y) in pts {
+        let basis = [1.0, x, x * x];
+        for r in 0..3 {
+            rhs[r] += basis[r] * y;
+            for c in 0..3 {
+                m[r * 3 + c] += basis[r] * basis[c];
+            }
+        }
+    }
+    let sol = solve(&mut m, &mut rhs, 3);
+    sol[2].is_finite().then_some(sol[2])
+}
+
+/// Marks edges the joint fit found unconstrained (flat cost) as such, keeping the paper's
+/// reason where it had one.
+pub fn edge_statuses(light: &FittedLight, u: &Uncertainty) -> [EdgeStatus; 4] {
+    let mut out = light.edges.clone();
+    for side in EdgeSide::ALL {
+        if u.edges[side as usize].is_none()
+            && matches!(out[side as usize], EdgeStatus::Constrained { .. })
+        {
+            out[side as usize] = EdgeStatus::Unconstrained {
+                reason: "moving this edge does not change the modelled photo".into(),
+            };
+        }
+    }
+    out
+}
