@@ -138,8 +138,12 @@ fn main() {
             Err(e) => format!("error: {e} | | "),
         };
         println!(
-            "| {} | {} | {} | {} |",
-            case.name, case.truth, case.paper, ours
+            "| {} | {} | {} | {} | {} |",
+            case.name,
+            case.truth,
+            case.paper,
+            method.name(),
+            ours
         );
     }
     let _ = std::fs::remove_dir_all(&dir);
