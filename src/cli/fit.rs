@@ -6,6 +6,8 @@ use streaklight::convert::{convert, describe, ConvertOptions, Method};
 use streaklight::optics::Shadowing;
 use streaklight::scene_in::LoadOptions;
 
+use super::streak_args::StreakArgs;
+
 /// Arguments of `streaklight fit`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -61,6 +63,9 @@ pub struct Args {
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]
     pub allow_empty: bool,
+    /// Streak-extraction settings.
+    #[command(flatten)]
+    pub streak: StreakArgs,
 }
 
 /// Runs the command.
@@ -88,7 +93,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         },
         fallback_quads: !args.no_fallback_quads,
         allow_empty: args.allow_empty,
-        streak_params: Default::default(),
+        streak_params: args.streak.params()?,
         method: if args.method == "paper" {
             Method::Paper
         } else {

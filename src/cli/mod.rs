@@ -4,3 +4,4 @@ pub mod fit;
 pub mod render;
 pub mod samples;
 pub mod segment;
+pub mod streak_args;

@@ -3,7 +3,9 @@
 use std::path::PathBuf;
 
 use streaklight::scene_in::{self, LoadOptions};
-use streaklight::streaks::{self, pictures, report, StreakParams};
+use streaklight::streaks::{self, pictures, report};
+
+use super::streak_args::StreakArgs;
 use streaklight::{photo_in, water_mask, Error};
 
 /// Arguments of `streaklight segment`.
@@ -25,41 +27,14 @@ pub struct Args {
     /// Water node or mesh name (default: the one node whose name contains "water").
     #[arg(long)]
     pub water: Option<String>,
-    /// Number of superpixels K (default: one per 400 pixels).
-    #[arg(long)]
-    pub superpixels: Option<usize>,
-    /// SLIC compactness m.
-    #[arg(long, default_value_t = 10.0)]
-    pub compactness: f32,
-    /// Seed search: every k-th row.
-    #[arg(long, default_value_t = 8)]
-    pub seed_row_step: usize,
-    /// Seed threshold t on the value V (sRGB-encoded, 0 to 1).
-    #[arg(long, default_value_t = 0.35)]
-    pub seed_threshold: f32,
-    /// Gaussian blur sigma in pixels before the seed search.
-    #[arg(long, default_value_t = 1.5)]
-    pub blur: f32,
-    /// Histogram correlation at or above which two superpixels are one streak (-1 to 1).
-    #[arg(long, default_value_t = 0.5)]
-    pub similarity: f32,
-    /// Mean V below which a superpixel never joins a streak.
-    #[arg(long, default_value_t = 0.15)]
-    pub min_value: f32,
+    /// Streak-extraction settings.
+    #[command(flatten)]
+    pub streak: StreakArgs,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> streaklight::Result<()> {
-    let mut params = StreakParams::default();
-    params.slic.superpixels = args.superpixels;
-    params.slic.compactness = args.compactness;
-    params.seeds.row_step = args.seed_row_step;
-    params.seeds.threshold = args.seed_threshold;
-    params.seeds.blur_sigma = args.blur;
-    params.grow.similarity = args.similarity;
-    params.grow.min_value = args.min_value;
-    params.seeds.validate()?;
-    params.grow.validate()?;
+    let params = args.streak.params()?;
 
     let photo = photo_in::load(&args.photo, args.exposure)?;
     let scene = scene_in::load(
@@ -73,18 +48,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    if let Some(aspect) = scene.camera.aspect_ratio {
-        let photo_aspect = photo.width as f32 / photo.height as f32;
-        if ((photo_aspect - aspect) / aspect).abs() > 0.005 {
-            return Err(Error::photo(
-                &args.photo,
-                format!(
-                    "the photo is {} x {} (aspect {photo_aspect:.4}) but the camera's aspect ratio is {aspect:.4}",
-                    photo.width, photo.height
-                ),
-            ));
-        }
-    }
+    streaklight::convert::check_photo(&scene, &photo, &args.photo)?;
     let water = water_mask::water_mask(&scene, photo.width, photo.height);
     let seg = streaks::extract_streaks(&photo, &water, &params).map_err(|e| match e {
         Error::NothingFound(m) => Error::NothingFound(format!("{}: {m}", args.photo.display())),
