@@ -205,3 +205,66 @@ fn dev_from_truth_t3() {
         );
     }
 }
+
+/// `fit --method joint` through the whole pipeline (real streak extraction) on the Table 1
+/// sample: every edge within 1 % of the light's size, radiance within 1 %, and a report with
+/// uncertainties that matches the schema.
+#[test]
+fn joint_method_through_the_converter() {
+    use streaklight::convert::{convert, ConvertOptions, Method};
+    let dir = std::env::temp_dir().join(format!("streaklight-joint-cli-{}", std::process::id()));
+    samples::write_scenes(&dir).expect("sample scenes");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let options = ConvertOptions {
+        scene: dir.join("scene.gltf"),
+        photo: root.join("samples/table1.png"),
+        output: dir.join("out.gltf"),
+        report: Some(dir.join("report.json")),
+        debug_dir: None,
+        load: Default::default(),
+        exposure: samples::PHOTO_EXPOSURE,
+        samples: streaklight::fitting::DEFAULT_SAMPLES,
+        seed: 1,
+        shadowing: streaklight::optics::Shadowing::None,
+        fallback_quads: true,
+        allow_empty: false,
+        streak_params: Default::default(),
+        method: Method::Joint,
+    };
+    let outcome = convert(&options).expect("joint fit");
+    assert_eq!(outcome.report.settings.method, "joint");
+    assert_eq!(outcome.report.lights.len(), 1);
+    let light = &outcome.report.lights[0];
+    let truth = samples::table1_light();
+    let c = light.corner_left_bottom;
+    let edges = [
+        (c[0], truth.corner.x),
+        (c[0] + light.width, truth.corner.x + truth.width),
+        (c[1], truth.corner.y),
+        (c[1] + light.height, truth.corner.y + truth.height),
+    ];
+    for (got, want) in edges {
+        assert!(
+            (got - want).abs() < 0.01 * truth.width,
+            "edge {got} vs {want}"
+        );
+    }
+    assert!(
+        (light.radiance[0] - 20.0).abs() < 0.2,
+        "{:?}",
+        light.radiance
+    );
+    assert!(
+        light.uncertainty.is_some(),
+        "the joint fit reports uncertainties"
+    );
+    let schema: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root.join("schema/report.schema.json")).unwrap(),
+    )
+    .unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let validator = jsonschema::validator_for(&schema).unwrap();
+    assert!(validator.is_valid(&report));
+    let _ = std::fs::remove_dir_all(&dir);
+}
