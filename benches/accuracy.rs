@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 
 use streaklight::convert::{convert, ConvertOptions, Method};
-use streaklight::optics::Shadowing;
 use streaklight::samples;
 use streaklight::scene_in::LoadOptions;
 
@@ -22,23 +21,17 @@ struct Case {
 fn options(dir: &Path, case: &Case, method: Method) -> ConvertOptions {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     ConvertOptions {
-        scene: dir.join(case.scene),
-        photo: root.join("samples").join(case.photo),
-        output: dir.join(format!("{}.gltf", case.name.replace([' ', ','], "_"))),
-        report: None,
-        debug_dir: None,
         load: LoadOptions {
             gloss: case.gloss,
             ..Default::default()
         },
         exposure: samples::PHOTO_EXPOSURE,
-        samples: streaklight::fitting::DEFAULT_SAMPLES,
-        seed: 1,
-        shadowing: Shadowing::None,
-        fallback_quads: true,
-        allow_empty: false,
-        streak_params: Default::default(),
         method,
+        ..ConvertOptions::new(
+            dir.join(case.scene),
+            root.join("samples").join(case.photo),
+            dir.join(format!("{}.gltf", case.name.replace([' ', ','], "_"))),
+        )
     }
 }
 

@@ -11,20 +11,12 @@ fn main() {
     let dir = std::env::temp_dir().join(format!("streaklight-bench-fit-{}", std::process::id()));
     samples::write_scenes(&dir).expect("writing the sample scenes");
     let options = ConvertOptions {
-        scene: dir.join("scene.gltf"),
-        photo: Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/table3.png"),
-        output: dir.join("lit.gltf"),
-        report: None,
-        debug_dir: None,
-        load: Default::default(),
         exposure: samples::PHOTO_EXPOSURE,
-        samples: streaklight::fitting::DEFAULT_SAMPLES,
-        seed: 1,
-        shadowing: streaklight::optics::Shadowing::None,
-        fallback_quads: true,
-        allow_empty: false,
-        streak_params: Default::default(),
-        method: Default::default(),
+        ..ConvertOptions::new(
+            dir.join("scene.gltf"),
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/table3.png"),
+            dir.join("lit.gltf"),
+        )
     };
     println!("threads: {}", rayon::current_num_threads());
     let mut best: Option<(f64, Vec<(String, f64)>)> = None;

@@ -81,6 +81,34 @@ pub struct ConvertOptions {
     pub method: Method,
 }
 
+impl ConvertOptions {
+    /// The options `streaklight fit SCENE PHOTO -o OUTPUT` runs with: exposure 1, the default
+    /// samples, seed 1, the paper's G = 1, fallback quads, no report or pictures, the paper
+    /// method. Change fields with struct update syntax.
+    pub fn new(
+        scene: impl Into<PathBuf>,
+        photo: impl Into<PathBuf>,
+        output: impl Into<PathBuf>,
+    ) -> Self {
+        ConvertOptions {
+            scene: scene.into(),
+            photo: photo.into(),
+            output: output.into(),
+            report: None,
+            debug_dir: None,
+            load: LoadOptions::default(),
+            exposure: 1.0,
+            samples: crate::fitting::DEFAULT_SAMPLES,
+            seed: 1,
+            shadowing: Shadowing::None,
+            fallback_quads: true,
+            allow_empty: false,
+            streak_params: StreakParams::default(),
+            method: Method::default(),
+        }
+    }
+}
+
 /// What a conversion produced.
 #[derive(Clone, Debug)]
 pub struct ConvertOutcome {

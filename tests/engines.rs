@@ -37,20 +37,13 @@ fn lit_scene_and_report(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     // A real `fit` of the Table 3 sample photo: what Babylon must reproduce is what the
     // report says, whatever the fit's accuracy.
     let options = streaklight::convert::ConvertOptions {
-        scene: input.clone(),
-        photo: Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/table3.png"),
-        output: output.clone(),
         report: Some(report.clone()),
-        debug_dir: None,
-        load: Default::default(),
         exposure: samples::PHOTO_EXPOSURE,
-        samples: streaklight::fitting::DEFAULT_SAMPLES,
-        seed: 1,
-        shadowing: streaklight::optics::Shadowing::None,
-        fallback_quads: true,
-        allow_empty: false,
-        streak_params: Default::default(),
-        method: Default::default(),
+        ..streaklight::convert::ConvertOptions::new(
+            &input,
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/table3.png"),
+            &output,
+        )
     };
     let outcome = streaklight::convert::convert(&options).expect("fitting the Table 3 sample");
     assert_eq!(outcome.report.lights.len(), 2, "Table 3 has two lights");

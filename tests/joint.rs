@@ -216,20 +216,14 @@ fn joint_method_through_the_converter() {
     samples::write_scenes(&dir).expect("sample scenes");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let options = ConvertOptions {
-        scene: dir.join("scene.gltf"),
-        photo: root.join("samples/table1.png"),
-        output: dir.join("out.gltf"),
         report: Some(dir.join("report.json")),
-        debug_dir: None,
-        load: Default::default(),
         exposure: samples::PHOTO_EXPOSURE,
-        samples: streaklight::fitting::DEFAULT_SAMPLES,
-        seed: 1,
-        shadowing: streaklight::optics::Shadowing::None,
-        fallback_quads: true,
-        allow_empty: false,
-        streak_params: Default::default(),
         method: Method::Joint,
+        ..ConvertOptions::new(
+            dir.join("scene.gltf"),
+            root.join("samples/table1.png"),
+            dir.join("out.gltf"),
+        )
     };
     let outcome = convert(&options).expect("joint fit");
     assert_eq!(outcome.report.settings.method, "joint");

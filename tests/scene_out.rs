@@ -258,30 +258,16 @@ struct Loaded {
     glb_chunks: Vec<(u32, Vec<u8>)>,
 }
 
-fn percent_decode(s: &str) -> String {
-    let b = s.as_bytes();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' && i + 2 < b.len() + 1 {
-            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                out.push(v);
-                i += 3;
-                continue;
-            }
-        }
-        out.push(b[i]);
-        i += 1;
-    }
-    String::from_utf8(out).unwrap()
-}
-
 /// The file a relative URI points at, from the document at `doc`.
 fn resolve(doc: &Path, uri: &str) -> Option<PathBuf> {
     if uri.starts_with("data:") {
         return None;
     }
-    Some(doc.parent().unwrap().join(percent_decode(uri)))
+    Some(
+        doc.parent()
+            .unwrap()
+            .join(streaklight::scene_in::document::percent_decode(uri)),
+    )
 }
 
 /// Reads a .gltf/.glb and every buffer it refers to (data URIs, files, the BIN chunk).

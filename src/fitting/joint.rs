@@ -697,15 +697,8 @@ pub fn fit_joint(
     start: &[FittedLight],
     options: &JointOptions,
 ) -> Result<JointOutcome> {
+    super::check_sizes(photo, water)?;
     let n_all = photo.width as usize * photo.height as usize;
-    if photo.radiance.len() != n_all || photo.clipped.len() != n_all || water.len() != n_all {
-        return Err(Error::Usage(format!(
-            "the photo ({} x {}) and its water mask ({} pixels) do not match",
-            photo.width,
-            photo.height,
-            water.len()
-        )));
-    }
     if options.samples == 0 {
         return Err(Error::Usage(
             "the joint fit needs at least one sample per pixel".into(),

@@ -216,6 +216,20 @@ pub struct FitOutcome {
     pub timings: Vec<(String, f64)>,
 }
 
+/// Refuses a photo and water mask of different sizes (the fitters index one by the other).
+pub(crate) fn check_sizes(photo: &Photo, water: &[bool]) -> Result<()> {
+    let n = photo.width as usize * photo.height as usize;
+    if photo.radiance.len() != n || photo.clipped.len() != n || water.len() != n {
+        return Err(Error::Usage(format!(
+            "the photo ({} x {}) and its water mask ({} pixels) do not match",
+            photo.width,
+            photo.height,
+            water.len()
+        )));
+    }
+    Ok(())
+}
+
 /// Fits one rectangle light per streak (METHOD §5 steps 7-9), merging fragments of one light.
 ///
 /// `water` is the water mask of the photo ([`crate::water_mask::water_mask`]); `streaks` come
@@ -228,15 +242,8 @@ pub fn fit_paper(
     streaks: &[StreakObservation],
     options: &FitOptions,
 ) -> Result<FitOutcome> {
-    let n = photo.width as usize * photo.height as usize;
-    if photo.radiance.len() != n || photo.clipped.len() != n || water.len() != n {
-        return Err(Error::Usage(format!(
-            "the photo ({} x {}) and its water mask ({} pixels) do not match",
-            photo.width,
-            photo.height,
-            water.len()
-        )));
-    }
+    check_sizes(photo, water)?;
+    let n = water.len();
     if options.samples == 0 {
         return Err(Error::Usage(
             "the fit needs at least one sample per pixel".into(),

@@ -15,24 +15,6 @@ pub struct Doc {
     pub buffers: Vec<Vec<u8>>,
 }
 
-fn percent_decode(s: &str) -> String {
-    let b = s.as_bytes();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' && i + 3 <= b.len() {
-            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                out.push(v);
-                i += 3;
-                continue;
-            }
-        }
-        out.push(b[i]);
-        i += 1;
-    }
-    String::from_utf8(out).unwrap()
-}
-
 /// Reads a .gltf/.glb and every buffer it refers to.
 pub fn load(path: &Path) -> Doc {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -62,8 +44,12 @@ pub fn load(path: &Path) -> Doc {
             Some(uri) if uri.starts_with("data:") => base64::engine::general_purpose::STANDARD
                 .decode(&uri[uri.find(',').unwrap() + 1..])
                 .unwrap(),
-            Some(uri) => std::fs::read(path.parent().unwrap().join(percent_decode(uri)))
-                .unwrap_or_else(|e| panic!("{}: buffer {uri}: {e}", path.display())),
+            Some(uri) => std::fs::read(
+                path.parent()
+                    .unwrap()
+                    .join(streaklight::scene_in::document::percent_decode(uri)),
+            )
+            .unwrap_or_else(|e| panic!("{}: buffer {uri}: {e}", path.display())),
         };
         assert!(data.len() >= len, "buffer shorter than its byteLength");
         buffers.push(data[..len].to_vec());
@@ -118,7 +104,10 @@ pub fn assert_keeps_everything(input: &Path, output: &Path) {
             if uri.starts_with("data:") {
                 return None;
             }
-            doc.parent()?.join(percent_decode(uri)).canonicalize().ok()
+            doc.parent()?
+                .join(streaklight::scene_in::document::percent_decode(uri))
+                .canonicalize()
+                .ok()
         };
         let (x, y) = (same_file(&a.json, input), same_file(&b.json, output));
         !(x.is_some() && x == y)
