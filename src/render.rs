@@ -3,7 +3,8 @@
 //!
 //! Per pixel, jittered camera rays integrate over the pixel's footprint (METHOD §2). A camera
 //! ray that hits a light sees its radiance; one that hits the water samples the reflection
-//! lobe once and sees what the reflected ray's closest hit is; everything else is black
+//! lobe a few times and each reflected ray sees the light it reaches unoccluded, if any;
+//! everything else is black
 //! (night). Each pixel draws its random numbers from its own stream, so the image does not
 //! depend on how many threads render it.
 

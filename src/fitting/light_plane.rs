@@ -219,10 +219,11 @@ pub fn find_plane(
     }
 }
 
-/// One camera sample of pixel (x, y) reflected off the water, drawn exactly as
-/// [`crate::render`]'s pixel sample draws it (same random numbers in the same order, same
-/// normals and offset): the reflected ray's origin and direction together with the lobe
-/// sample, or `None` when the sample reflects nothing (the jittered ray misses the water, or
+/// One camera sample of pixel (x, y) reflected off the water, with the renderer's model
+/// ([`crate::render`]: a jittered camera ray, the same shading and face normals, the same
+/// offset; the renderer additionally stratifies its camera rays and shares each among several
+/// lobe samples, which changes the noise but not the expectation): the reflected ray's origin
+/// together with the lobe sample, or `None` when the sample reflects nothing (the jittered ray misses the water, or
 /// the lobe sample is below the surface).
 pub fn reflected_sample(
     scene: &Scene,
