@@ -251,7 +251,7 @@ fn edge_report(status: &EdgeStatus) -> EdgeReport {
             pixels: *pixels,
             reason: None,
         },
-        EdgeStatus::Unconstrained { reason } => EdgeReport {
+        EdgeStatus::Unconstrained { reason, .. } => EdgeReport {
             status: "unconstrained".into(),
             pixels: 0,
             reason: Some(reason.clone()),

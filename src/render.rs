@@ -132,6 +132,74 @@ pub fn surface_offset(p: Vec3) -> f32 {
     1e-5 * (1.0 + p.abs().max_element())
 }
 
+/// Where a camera ray meets the water, with what its reflected rays need.
+#[derive(Clone, Copy, Debug)]
+pub struct WaterPoint {
+    /// Origin of the reflected rays: the hit lifted off the surface on the camera's side.
+    pub start: Vec3,
+    /// Unit direction back towards the camera.
+    pub wo: Vec3,
+    /// Shading normal (the lobe's axis).
+    pub normal: Vec3,
+    /// Geometric normal, turned to the camera's side.
+    pub face: Vec3,
+}
+
+impl WaterPoint {
+    /// One reflected lobe sample for the uniform pair `u`; `None` when the model rejects it
+    /// or the ray would enter the water geometrically (it then sees nothing, but still
+    /// counts in the pixel's mean).
+    pub fn reflect(&self, model: &ReflectionModel, u: Vec2) -> Option<crate::optics::LobeSample> {
+        let sample = model.sample(self.normal, self.wo, u)?;
+        (self.face.dot(sample.wi) > 0.0).then_some(sample)
+    }
+}
+
+/// What a camera ray sees first.
+pub enum CameraHit {
+    /// Area light `index`, directly.
+    Light(usize),
+    /// The water.
+    Water(WaterPoint),
+    /// Anything else, or nothing: black at night.
+    Other,
+}
+
+/// Traces the camera ray through image position (`x`, `y`) (pixel units, fractional) of a
+/// `width` x `height` image. The renderer and the fitter's footprints share it, so that the
+/// fit models exactly the pixel the renderer makes.
+pub fn camera_hit(
+    scene: &Scene,
+    lights: &[AreaLight],
+    x: f32,
+    y: f32,
+    width: u32,
+    height: u32,
+) -> CameraHit {
+    let origin = scene.camera.position;
+    let dir = scene.camera.direction(x, y, width, height);
+    let hit = match trace(scene, lights, origin, dir, 0.0) {
+        SceneHit::Light(i) => return CameraHit::Light(i),
+        SceneHit::Miss => return CameraHit::Other,
+        SceneHit::Surface(hit) => hit,
+    };
+    if !scene.is_water[hit.triangle as usize] {
+        return CameraHit::Other;
+    }
+    let p = origin + dir * hit.t;
+    let wo = -dir;
+    let mut face = scene.face_normal(hit.triangle);
+    if face.dot(wo) < 0.0 {
+        face = -face;
+    }
+    CameraHit::Water(WaterPoint {
+        start: p + face * surface_offset(p),
+        wo,
+        normal: scene.shading_normal(hit.triangle, hit.barycentric),
+        face,
+    })
+}
+
 /// Renders the scene's water and lights as the camera sees them.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Rendered> {
     render_with_lights(scene, &scene.area_lights, options)
@@ -263,39 +331,20 @@ fn pixel_sample(
         fx = ((s.stratum % s.strata) as f32 + fx) / n;
         fy = ((s.stratum / s.strata) as f32 + fy) / n;
     }
-    let origin = scene.camera.position;
-    let dir = scene
-        .camera
-        .direction(s.x as f32 + fx, s.y as f32 + fy, w, h);
-    let hit = match trace(scene, lights, origin, dir, 0.0) {
-        SceneHit::Light(i) => return (lights[i].radiance, 0),
-        SceneHit::Miss => return ([0.0; 3], 0),
-        SceneHit::Surface(hit) => hit,
+    let water = match camera_hit(scene, lights, s.x as f32 + fx, s.y as f32 + fy, w, h) {
+        CameraHit::Light(i) => return (lights[i].radiance, 0),
+        CameraHit::Other => return ([0.0; 3], 0),
+        CameraHit::Water(water) => water,
     };
-    if !scene.is_water[hit.triangle as usize] {
-        return ([0.0; 3], 0);
-    }
-    let p = origin + dir * hit.t;
-    let wo = -dir;
-    let n = scene.shading_normal(hit.triangle, hit.barycentric);
-    let mut face = scene.face_normal(hit.triangle);
-    if face.dot(wo) < 0.0 {
-        face = -face;
-    }
-    let start = p + face * surface_offset(p);
     let mut sum = [0f32; 3];
     let mut traced = 0;
     for _ in 0..s.lobe_samples {
         let u = Vec2::new(rng.next_f32(), rng.next_f32());
-        let Some(sample) = model.sample(n, wo, u) else {
+        let Some(sample) = water.reflect(model, u) else {
             continue;
         };
-        // A reflected ray that would enter the water geometrically sees nothing.
-        if face.dot(sample.wi) <= 0.0 {
-            continue;
-        }
         traced += 1;
-        if let Some(i) = visible_light(scene, lights, start, sample.wi, 0.0) {
+        if let Some(i) = visible_light(scene, lights, water.start, sample.wi, 0.0) {
             let l = lights[i].radiance;
             for c in 0..3 {
                 sum[c] += l[c] * sample.weight;

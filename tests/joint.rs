@@ -195,7 +195,11 @@ fn dev_from_truth_t3() {
         start[k].v_max = b.y;
         start[k].radiance = truth.radiance.map(|c| c as f32);
     }
-    let jo = JointOptions::new(options.model, 1);
+    let mut jo = JointOptions::new(options.model, 1);
+    let env = |k: &str, d: u32| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    jo.samples = env("DEV_SAMPLES", 128);
+    jo.sweeps = env("DEV_SWEEPS", 14);
+    jo.checkerboard = env("DEV_CHECKER", 1) == 1;
     let j = fit_joint(&scene, &photo, &water, &streaks, &start, &jo).unwrap();
     for (k, truth) in samples::table3_lights().iter().enumerate() {
         let (e, r) = errors(&j.lights[k], truth, scene.origin);
@@ -261,4 +265,59 @@ fn joint_method_through_the_converter() {
     let validator = jsonschema::validator_for(&schema).unwrap();
     assert!(validator.is_valid(&report));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+#[ignore]
+fn dev_dump_truth_t1() {
+    let scene = sample_scene("scene.gltf", None);
+    let photo = sample_photo("table1.png");
+    let water = water_mask(&scene, photo.width, photo.height);
+    let streaks = threshold_streaks(&photo, &water, STREAK_THRESHOLD, 200);
+    let options = FitOptions::for_scene(&scene);
+    let paper = fit_paper(&scene, &photo, &water, &streaks, &options).unwrap();
+    let truth = samples::table1_light();
+    let mut start = paper.lights.clone();
+    let pl = &start[0].plane;
+    let a = pl.coords((truth.corner - scene.origin).as_vec3());
+    let b = pl.coords(
+        (truth.corner + glam::DVec3::new(truth.width, truth.height, 0.0) - scene.origin).as_vec3(),
+    );
+    start[0].u_min = a.x;
+    start[0].v_min = a.y;
+    start[0].u_max = b.x;
+    start[0].v_max = b.y;
+    start[0].radiance = [20.0; 3];
+    let mut jo = JointOptions::new(options.model, 1);
+    jo.sweeps = 0;
+    jo.samples = 1024;
+    jo.margin = 20;
+    jo.checkerboard = false;
+    let j0 = fit_joint(&scene, &photo, &water, &streaks, &start, &jo).unwrap();
+    eprintln!("L {:?} sigma2 {:.4e}", j0.lights[0].radiance, j0.residual_variance);
+}
+
+#[test]
+#[ignore]
+fn dev_configs_t1() {
+    let scene = sample_scene("scene.gltf", None);
+    let photo = sample_photo(&std::env::var("DEV_PHOTO").unwrap_or("table1.png".into()));
+    let water = water_mask(&scene, photo.width, photo.height);
+    let streaks = threshold_streaks(&photo, &water, STREAK_THRESHOLD, 200);
+    let options = FitOptions::for_scene(&scene);
+    let paper = fit_paper(&scene, &photo, &water, &streaks, &options).unwrap();
+    let env = |k: &str, d: u32| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    let mut jo = JointOptions::new(options.model, 1);
+    jo.samples = env("DEV_SAMPLES", 96);
+    jo.margin = env("DEV_MARGIN", 6);
+    jo.checkerboard = env("DEV_CHECKER", 1) == 1;
+    jo.sweeps = env("DEV_SWEEPS", 14);
+    let t = std::time::Instant::now();
+    let j = fit_joint(&scene, &photo, &water, &streaks, &paper.lights, &jo).unwrap();
+    let truths = if photo.width > 0 && std::env::var("DEV_PHOTO").map(|p| p.contains("table3")).unwrap_or(false) { samples::table3_lights() } else { vec![samples::table1_light()] };
+    for (k, truth) in truths.iter().enumerate() {
+        let (e, r) = errors(&j.lights[k], truth, scene.origin);
+        eprintln!("light{k}: edges % {:?} rad {r:.4} sigma2 {:.4e} pixels {} {:?} total {:.2}", e.map(|e| (e * 1e4).round() / 1e2), j.residual_variance, j.pixels, j.timings, t.elapsed().as_secs_f64());
+        eprintln!("   unc {:?}", j.uncertainty[k]);
+    }
 }

@@ -25,16 +25,16 @@
 
 use std::time::Instant;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::light_plane::{reflected_sample, LightPlane};
+use super::light_plane::LightPlane;
 use super::rect::Rect;
 use super::{EdgeSide, EdgeStatus, FittedLight, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::random::Rng;
-use crate::render::{trace, SceneHit};
+use crate::render::{camera_hit, trace, CameraHit, SceneHit};
 use crate::scene_in::Scene;
 use crate::{Error, Result};
 
@@ -106,6 +106,8 @@ pub struct JointOutcome {
 }
 
 /// Stored samples of one light's plane: per fitted pixel, a range of points and weights.
+/// A weight's sign tells which of the pixel's two independent halves of samples it belongs
+/// to (negative: the second), which is what the coefficients' variance is estimated from.
 struct PlaneSamples {
     offsets: Vec<u32>,
     /// Per pixel, the bounding box of its samples (empty pixels: an inverted box).
@@ -122,44 +124,56 @@ impl PlaneSamples {
     /// `(c, var(c))`: the coefficient and the variance of its estimate.
     fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> (f32, f32) {
         let r = self.range(i);
-        let (mut sum, mut sum2) = (0f32, 0f32);
+        let (mut sum, mut half_difference) = (0f32, 0f32);
         for (p, &w) in self.points[r.clone()].iter().zip(&self.weights[r]) {
             if rect.contains(*p) {
-                sum += w;
-                sum2 += w * w;
+                sum += w.abs();
+                half_difference += w;
             }
         }
-        let c = sum * inv_samples;
-        (c, estimate_variance(c, sum2, inv_samples))
+        (
+            sum * inv_samples,
+            estimate_variance(half_difference, inv_samples),
+        )
     }
 }
 
-/// Variance of a coefficient estimated as the mean of N sample weights (`sum2` = sum of the
-/// squared weights inside the rectangle, `inv_n` = 1/N).
+/// Variance of a coefficient estimated from two independent halves of its samples, given
+/// the halves' difference of weight sums (`inv_n` = 1 / all samples): with A and B the two
+/// half estimates, the coefficient is (A + B) / 2 and (A - B)^2 / 4 estimates its variance
+/// without bias, whatever the stratification inside each half.
 ///
 /// Why it matters: the coefficients are themselves Monte Carlo estimates, and least squares
 /// with a noisy regressor is biased (sum c_hat^2 overestimates sum c^2 by the summed
-/// variance, pulling the radiance low by a percent or more at ~100 samples and pushing the
-/// edges outwards to compensate). Subtracting the estimated variance from the normal
-/// equations removes that bias.
-fn estimate_variance(c: f32, sum2: f32, inv_n: f32) -> f32 {
-    let n = 1.0 / inv_n;
-    if n < 2.0 {
-        return 0.0;
-    }
-    ((sum2 * inv_n - c * c) / (n - 1.0)).max(0.0)
+/// variance, pulling the radiance low and pushing the edges to compensate; the weakly seen
+/// edges move by a percent). Subtracting the estimated variance from the normal equations
+/// removes that bias. The textbook estimate from the spread of individual samples would
+/// assume independent samples, and overestimate the variance of stratified ones.
+fn estimate_variance(half_difference: f32, inv_n: f32) -> f32 {
+    let d = half_difference * inv_n;
+    d * d
 }
 
 /// The fitting problem: observed pixels and every light's stored samples.
 struct Problem {
+    pixel_ids: Vec<u32>,
     obs: Vec<[f32; 3]>,
     clipped: Vec<bool>,
     planes: Vec<PlaneSamples>,
     inv_samples: f32,
 }
 
-/// The pixels of the fitted region: the lights' streaks dilated by `margin`, water only.
+/// The pixels of the fitted region, water only: the lights' streaks dilated by `margin`, and
+/// every other pixel near them from which the reflected rays can reach a light's region of
+/// interest. The second part matters as much as the first: a streak's faint ends fall below
+/// any segmentation's threshold, and a pixel the fit does not look at cannot object to a
+/// light that grew into it (an edge seen only through such ends then drifts by percents).
+#[allow(clippy::too_many_arguments)]
 fn region(
+    scene: &Scene,
+    model: &ReflectionModel,
+    planes: &[&LightPlane],
+    roi: &[Rect],
     photo: &Photo,
     water: &[bool],
     streaks: &[&StreakObservation],
@@ -169,55 +183,175 @@ fn region(
     let (w, h) = (photo.width as i64, photo.height as i64);
     let m = margin as i64;
     let mut mark = vec![false; (w * h) as usize];
+    // Per streak, its bounding box grown by a quarter of its size: where its faint ends lie.
+    let mut boxes = Vec::new();
     for s in streaks {
+        let (mut x0, mut y0, mut x1, mut y1) = (w, h, -1i64, -1i64);
         for &p in &s.pixels {
             let (x, y) = (p as i64 % w, p as i64 / w);
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
             for yy in (y - m).max(0)..=(y + m).min(h - 1) {
                 for xx in (x - m).max(0)..=(x + m).min(w - 1) {
                     mark[(yy * w + xx) as usize] = true;
                 }
             }
         }
+        if x1 >= x0 {
+            let (dx, dy) = (m + (x1 - x0) / 4, m + (y1 - y0) / 4);
+            boxes.push((
+                (x0 - dx).max(0),
+                (y0 - dy).max(0),
+                (x1 + dx).min(w - 1),
+                (y1 + dy).min(h - 1),
+            ));
+        }
     }
-    (0..(w * h) as usize)
-        .filter(|&i| mark[i] && water[i])
-        .filter(|&i| !checkerboard || (i as i64 % w + i as i64 / w) % 2 == 0)
+    let keep = |i: usize| water[i] && (!checkerboard || (i as i64 % w + i as i64 / w) % 2 == 0);
+    let mut pixels: Vec<u32> = (0..(w * h) as usize)
+        .filter(|&i| mark[i] && keep(i))
         .map(|i| i as u32)
-        .collect()
+        .collect();
+    let mut candidate = vec![false; (w * h) as usize];
+    for &(x0, y0, x1, y1) in &boxes {
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                candidate[(y * w + x) as usize] = true;
+            }
+        }
+    }
+    {
+        let candidates: Vec<u32> = (0..(w * h) as usize)
+            .filter(|&i| candidate[i] && !mark[i] && keep(i))
+            .map(|i| i as u32)
+            .collect();
+        let seen: Vec<u32> = candidates
+            .into_par_iter()
+            .filter(|&i| sees_region_of_interest(scene, model, planes, roi, i, photo))
+            .collect();
+        pixels.extend(seen);
+        pixels.sort_unstable();
+    }
+    pixels
 }
 
-/// Traces `samples` lobe samples of every pixel once and stores, per light, those whose first
-/// hit is that light's plane (a sample landing on a face shared by several lights is stored
-/// for each).
+/// Lobe directions per side tried from a pixel's centre by [`sees_region_of_interest`].
+const PROBE_STRATA: u32 = 6;
+
+/// Whether any of a few reflected rays from the pixel's centre meets a light's plane inside
+/// its region of interest (a geometric test only: occlusion is left to the fit's own
+/// samples).
+fn sees_region_of_interest(
+    scene: &Scene,
+    model: &ReflectionModel,
+    planes: &[&LightPlane],
+    roi: &[Rect],
+    pixel: u32,
+    photo: &Photo,
+) -> bool {
+    let (x, y) = (pixel % photo.width, pixel / photo.width);
+    let CameraHit::Water(water) = camera_hit(
+        scene,
+        &[],
+        x as f32 + 0.5,
+        y as f32 + 0.5,
+        photo.width,
+        photo.height,
+    ) else {
+        return false;
+    };
+    let inv = 1.0 / PROBE_STRATA as f32;
+    (0..PROBE_STRATA * PROBE_STRATA).any(|j| {
+        let u = Vec2::new(
+            ((j % PROBE_STRATA) as f32 + 0.5) * inv,
+            ((j / PROBE_STRATA) as f32 + 0.5) * inv,
+        );
+        water.reflect(model, u).is_some_and(|s| {
+            planes.iter().zip(roi).any(|(plane, r)| {
+                plane_point(plane, water.start, s.wi).is_some_and(|q| r.contains(q))
+            })
+        })
+    })
+}
+
+/// Camera rays per side of a pixel's stratification grid: 4 x 4 jittered camera rays cover
+/// the footprint evenly, and the lobe is sampled several times from each.
+const CAMERA_STRATA: u32 = 2;
+
+/// Lobe strata per side for `samples` samples per pixel. A pixel's samples are two
+/// independent halves (for the variance estimate), each `CAMERA_STRATA^2` camera rays times
+/// `lobe_strata^2` lobe samples, so the count is rounded to `32 b^2`. Stratifying the lobe
+/// matters: a coefficient is the lobe's mass inside a rectangle, and stratified samples
+/// estimate that with far less noise than independent ones, which is what lets the edges
+/// settle at the photo's optimum rather than at the samples' noise; reusing each camera
+/// ray's water hit for several lobe samples makes them cheap.
+fn lobe_strata(samples: u32) -> u32 {
+    let per_ray = samples as f32 / (2 * CAMERA_STRATA * CAMERA_STRATA) as f32;
+    (per_ray.sqrt().round() as u32).max(1)
+}
+
+/// Traces every pixel's samples once and stores, per light, those whose first hit is that
+/// light's plane inside its region of interest `roi[k]` (a sample landing on a face shared by
+/// several lights is stored for each). A sample whose ray meets no plane inside a region of
+/// interest is never traced: it could not change any coefficient the fit will evaluate.
 #[allow(clippy::too_many_arguments)]
 fn trace_samples(
     scene: &Scene,
     model: &ReflectionModel,
     planes: &[&LightPlane],
+    roi: &[Rect],
     pixels: &[u32],
     width: u32,
     height: u32,
     samples: u32,
     seed: u64,
-) -> Vec<PlaneSamples> {
+) -> (Vec<PlaneSamples>, u32) {
     type Hits = Vec<(u16, Vec2, f32)>;
+    let lobe = lobe_strata(samples);
+    let per_pixel_samples = 2 * CAMERA_STRATA * CAMERA_STRATA * lobe * lobe;
     let per_pixel: Vec<Hits> = pixels
         .par_iter()
         .map(|&pixel| {
             let mut rng = Rng::new(seed, JOINT_STREAM | pixel as u64);
             let (x, y) = (pixel % width, pixel / width);
             let mut hits = Vec::new();
-            for _ in 0..samples {
-                let Some((start, s)) =
-                    reflected_sample(scene, model, x, y, width, height, &mut rng)
+            let inv_c = 1.0 / CAMERA_STRATA as f32;
+            let inv_l = 1.0 / lobe as f32;
+            for (cs, half_sign) in (0..2 * CAMERA_STRATA * CAMERA_STRATA)
+                .map(|i| (i % (CAMERA_STRATA * CAMERA_STRATA), if i < CAMERA_STRATA * CAMERA_STRATA { 1.0 } else { -1.0 }))
+            {
+                let fx = ((cs % CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
+                let fy = ((cs / CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
+                let CameraHit::Water(water) =
+                    camera_hit(scene, &[], x as f32 + fx, y as f32 + fy, width, height)
                 else {
+                    // Draw the lobe numbers anyway, so that every camera ray of a pixel uses
+                    // the same stream positions whatever the others hit.
+                    for _ in 0..lobe * lobe {
+                        rng.next_f32();
+                        rng.next_f32();
+                    }
                     continue;
                 };
-                if let SceneHit::Surface(hit) = trace(scene, &[], start, s.wi, 0.0) {
-                    let p = start + s.wi * hit.t;
-                    for (k, plane) in planes.iter().enumerate() {
-                        if plane.contains_triangle(scene, hit.triangle) {
-                            hits.push((k as u16, plane.coords(p), s.weight));
+                for ls in 0..lobe * lobe {
+                    let u = Vec2::new(
+                        ((ls % lobe) as f32 + rng.next_f32()) * inv_l,
+                        ((ls / lobe) as f32 + rng.next_f32()) * inv_l,
+                    );
+                    let Some(s) = water.reflect(model, u) else {
+                        continue;
+                    };
+                    let wanted = planes.iter().zip(roi).any(|(plane, r)| {
+                        plane_point(plane, water.start, s.wi).is_some_and(|q| r.contains(q))
+                    });
+                    if !wanted {
+                        continue;
+                    }
+                    if let SceneHit::Surface(hit) = trace(scene, &[], water.start, s.wi, 0.0) {
+                        let p = water.start + s.wi * hit.t;
+                        for (k, plane) in planes.iter().enumerate() {
+                            if plane.contains_triangle(scene, hit.triangle) {
+                                hits.push((k as u16, plane.coords(p), half_sign * s.weight));
+                            }
                         }
                     }
                 }
@@ -225,7 +359,7 @@ fn trace_samples(
             hits
         })
         .collect();
-    (0..planes.len())
+    let stored = (0..planes.len())
         .map(|k| {
             let mut out = PlaneSamples {
                 offsets: Vec::with_capacity(pixels.len() + 1),
@@ -259,7 +393,19 @@ fn trace_samples(
             }
             out
         })
-        .collect()
+        .collect();
+    (stored, per_pixel_samples)
+}
+
+/// Plane coordinates where the ray from `start` along `dir` meets `plane`'s front side, if it
+/// does.
+fn plane_point(plane: &LightPlane, start: Vec3, dir: Vec3) -> Option<Vec2> {
+    let denom = dir.dot(plane.normal);
+    if denom >= 0.0 {
+        return None;
+    }
+    let t = (plane.point - start).dot(plane.normal) / denom;
+    (t > 0.0).then(|| plane.coords(start + dir * t))
 }
 
 /// Solves the nonnegative least squares `min |b - A x|^2, x >= 0` for a small dense system
@@ -470,11 +616,9 @@ impl Problem {
         }
     }
 
-    /// The cost, as a function of one edge of light `k` on the grid `lo + j * step`
-    /// (`j < grid`), with light k's radiance re-optimised (closed form, nonnegative) at every
-    /// grid point and the other lights held. Returns per grid point (cost up to a constant,
-    /// the radiance).
-    fn edge_profile(
+    /// The sums of [`Problem::edge_profile`] over the fitted pixels `chunk`.
+    #[allow(clippy::too_many_arguments)]
+    fn profile_sums(
         &self,
         st: &State,
         k: usize,
@@ -482,19 +626,18 @@ impl Problem {
         lo: f32,
         step: f32,
         grid: usize,
-    ) -> Vec<(f64, [f64; 3])> {
+        chunk: &[usize],
+    ) -> ProfileSums {
         let rect = st.rects[k];
         let plane = &self.planes[k];
-        // Residual against the other lights.
-        let n = self.n();
         let mut a = vec![0f64; grid];
         let mut a_raw = vec![0f64; grid];
         let mut b = vec![[0f64; 3]; grid];
         let mut cvals = vec![0f32; grid];
-        let mut wsq = vec![0f32; grid];
+        let mut half_difference = vec![0f32; grid];
         // Clipped pixels need the whole c(t) to apply their one-sided residual later.
         let mut clipped_rows: Vec<(usize, Vec<f32>)> = Vec::new();
-        for i in 0..n {
+        for &i in chunk {
             let r = plane.range(i);
             if r.is_empty() {
                 continue;
@@ -530,7 +673,7 @@ impl Problem {
                 continue;
             }
             cvals.iter_mut().for_each(|c| *c = 0.0);
-            wsq.iter_mut().for_each(|c| *c = 0.0);
+            half_difference.iter_mut().for_each(|c| *c = 0.0);
             let mut any = false;
             for (p, &w) in plane.points[r.clone()].iter().zip(&plane.weights[r]) {
                 // Inside the rectangle's other three edges?
@@ -561,8 +704,8 @@ impl Problem {
                     EdgeSide::Right | EdgeSide::Top => {
                         let j = f.ceil().max(0.0);
                         if (j as usize) < grid {
-                            cvals[j as usize] += w;
-                            wsq[j as usize] += w * w;
+                            cvals[j as usize] += w.abs();
+                            half_difference[j as usize] += w;
                             any = true;
                         }
                     }
@@ -570,8 +713,8 @@ impl Problem {
                     EdgeSide::Left | EdgeSide::Bottom => {
                         let j = f.floor();
                         if j >= 0.0 {
-                            cvals[(j as usize).min(grid - 1)] += w;
-                            wsq[(j as usize).min(grid - 1)] += w * w;
+                            cvals[(j as usize).min(grid - 1)] += w.abs();
+                            half_difference[(j as usize).min(grid - 1)] += w;
                             any = true;
                         }
                     }
@@ -584,13 +727,13 @@ impl Problem {
                 EdgeSide::Right | EdgeSide::Top => {
                     for j in 1..grid {
                         cvals[j] += cvals[j - 1];
-                        wsq[j] += wsq[j - 1];
+                        half_difference[j] += half_difference[j - 1];
                     }
                 }
                 EdgeSide::Left | EdgeSide::Bottom => {
                     for j in (0..grid - 1).rev() {
                         cvals[j] += cvals[j + 1];
-                        wsq[j] += wsq[j + 1];
+                        half_difference[j] += half_difference[j + 1];
                     }
                 }
             }
@@ -612,11 +755,52 @@ impl Problem {
                 let cf = cvals[j] * self.inv_samples;
                 let c = cf as f64;
                 a_raw[j] += c * c;
-                a[j] += c * c - estimate_variance(cf, wsq[j], self.inv_samples) as f64;
+                a[j] += c * c - estimate_variance(half_difference[j], self.inv_samples) as f64;
                 for ch in 0..3 {
                     b[j][ch] += c * res[ch];
                 }
             }
+        }
+        ProfileSums {
+            a,
+            a_raw,
+            b,
+            clipped_rows,
+        }
+    }
+
+    /// The cost, as a function of one edge of light `k` on the grid `lo + j * step`
+    /// (`j < grid`), with light k's radiance re-optimised (closed form, nonnegative) at every
+    /// grid point and the other lights held. Returns per grid point (cost up to a constant,
+    /// the radiance).
+    fn edge_profile(
+        &self,
+        st: &State,
+        k: usize,
+        side: EdgeSide,
+        lo: f32,
+        step: f32,
+        grid: usize,
+    ) -> Vec<(f64, [f64; 3])> {
+        // Fixed chunks summed in order: the same sums whatever the thread count.
+        let parts: Vec<ProfileSums> = (0..self.n())
+            .collect::<Vec<_>>()
+            .par_chunks(PROFILE_CHUNK)
+            .map(|chunk| self.profile_sums(st, k, side, lo, step, grid, chunk))
+            .collect();
+        let mut a = vec![0f64; grid];
+        let mut a_raw = vec![0f64; grid];
+        let mut b = vec![[0f64; 3]; grid];
+        let mut clipped_rows: Vec<(usize, Vec<f32>)> = Vec::new();
+        for part in parts {
+            for j in 0..grid {
+                a[j] += part.a[j];
+                a_raw[j] += part.a_raw[j];
+                for ch in 0..3 {
+                    b[j][ch] += part.b[j][ch];
+                }
+            }
+            clipped_rows.extend(part.clipped_rows);
         }
         // Pixels with no sample of light k contribute a constant, left out.
         // A rectangle that catches only a few samples has a variance as large as its mean
@@ -661,6 +845,18 @@ impl Problem {
     }
 }
 
+/// Pixels per parallel piece of an edge profile.
+const PROFILE_CHUNK: usize = 2048;
+
+/// Per grid point of an edge profile: the normal-equation sums over some pixels, and the
+/// clipped pixels' coefficients (they enter the cost one-sidedly, so they are kept whole).
+struct ProfileSums {
+    a: Vec<f64>,
+    a_raw: Vec<f64>,
+    b: Vec<[f64; 3]>,
+    clipped_rows: Vec<(usize, Vec<f32>)>,
+}
+
 /// How far the photo could possibly move an edge: the extent of light k's stored samples.
 fn sample_extent(p: &PlaneSamples) -> Option<Rect> {
     let mut it = p.points.iter();
@@ -683,6 +879,24 @@ fn sample_extent(p: &PlaneSamples) -> Option<Rect> {
 const GRID: usize = 65;
 /// Smallest search half-window, metres: well under the 0.5 % of a metre-sized light asked for.
 const MIN_WINDOW: f32 = 2e-4;
+
+/// Half-width of the first search window around a start edge: half the light's size, at
+/// least 0.5 m, so that an estimate a light's size off is still inside the first grid.
+fn first_window(r: &Rect) -> f32 {
+    (0.5 * r.width().max(r.height())).max(0.5)
+}
+
+/// Where on its plane a light's edges may go during the fit: the start rectangle grown by
+/// the first search window and a little more. Samples landing outside it are never traced.
+fn region_of_interest(start: &Rect) -> Rect {
+    let grow = 1.5 * first_window(start);
+    Rect {
+        u_min: start.u_min - grow,
+        u_max: start.u_max + grow,
+        v_min: start.v_min - grow,
+        v_max: start.v_max + grow,
+    }
+}
 
 /// Refines `start` (typically the paper's per-streak estimate) by fitting all lights together
 /// to every water pixel of their streaks and surroundings (see the module doc).
@@ -727,12 +941,24 @@ pub fn fit_joint(
         )));
     }
     let t0 = Instant::now();
-    let pixels = region(photo, water, &used, options.margin, options.checkerboard);
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
-    let stored = trace_samples(
+    let roi: Vec<Rect> = start.iter().map(|l| region_of_interest(&l.rect())).collect();
+    let pixels = region(
         scene,
         &options.model,
         &planes,
+        &roi,
+        photo,
+        water,
+        &used,
+        options.margin,
+        options.checkerboard,
+    );
+    let (stored, per_pixel_samples) = trace_samples(
+        scene,
+        &options.model,
+        &planes,
+        &roi,
         &pixels,
         photo.width,
         photo.height,
@@ -742,10 +968,11 @@ pub fn fit_joint(
     let footprint_seconds = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let problem = Problem {
+        pixel_ids: pixels.clone(),
         obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
         clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
         planes: stored,
-        inv_samples: 1.0 / options.samples as f32,
+        inv_samples: 1.0 / per_pixel_samples as f32,
     };
     let (lights, uncertainty, variance) = optimise(&problem, start, options.sweeps);
     Ok(JointOutcome {
@@ -806,15 +1033,18 @@ fn optimise(
     let mut windows: Vec<[f32; 4]> = st
         .rects
         .iter()
-        .map(|r| {
-            let s = (0.5 * r.width().max(r.height())).max(0.5);
-            [s; 4]
-        })
+        .map(|r| [first_window(r); 4])
         .collect();
     for _sweep in 0..sweeps {
         for k in 0..k_count {
             let Some(ext) = extents[k] else { continue };
             for side in EdgeSide::ALL {
+                if matches!(
+                    start[k].edges[side as usize],
+                    EdgeStatus::Unconstrained { unseen: true, .. }
+                ) {
+                    continue;
+                }
                 let half = windows[k][side as usize];
                 let cur = st.rects[k].edge(side);
                 let (lo, hi) = edge_bounds(&st.rects[k], side, &ext);
@@ -846,6 +1076,14 @@ fn optimise(
             }
         }
         problem.solve_radiance(&mut st);
+    }
+    if let Ok(path) = std::env::var("STREAKLIGHT_JOINT_DUMP") {
+        let mut out = String::new();
+        for i in 0..problem.n() {
+            let m = problem.model(&st, i);
+            out += &format!("{} {} {} {}\n", problem.pixel_ids[i], problem.obs[i][0], m[0], problem.clipped[i] as u8);
+        }
+        let _ = std::fs::write(path, out);
     }
     let cost = problem.cost(&st);
     let dof = (problem.n() * 3).saturating_sub(7 * k_count).max(1);
@@ -970,6 +1208,7 @@ pub fn edge_statuses(light: &FittedLight, u: &Uncertainty) -> [EdgeStatus; 4] {
         {
             out[side as usize] = EdgeStatus::Unconstrained {
                 reason: "moving this edge does not change the modelled photo".into(),
+                unseen: false,
             };
         }
     }

@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
-use crate::render::{surface_offset, trace, SceneHit};
+use crate::render::{camera_hit, trace, CameraHit, SceneHit};
 use crate::scene_in::Scene;
 
 /// The plane of one face of the scene (coplanar triangles of one glTF primitive), with the
@@ -237,26 +237,10 @@ pub fn reflected_sample(
     let jx = x as f32 + rng.next_f32();
     let jy = y as f32 + rng.next_f32();
     let u = Vec2::new(rng.next_f32(), rng.next_f32());
-    let origin = scene.camera.position;
-    let dir = scene.camera.direction(jx, jy, width, height);
-    let SceneHit::Surface(hit) = trace(scene, &[], origin, dir, 0.0) else {
+    let CameraHit::Water(water) = camera_hit(scene, &[], jx, jy, width, height) else {
         return None;
     };
-    if !scene.is_water[hit.triangle as usize] {
-        return None;
-    }
-    let p = origin + dir * hit.t;
-    let wo = -dir;
-    let n = scene.shading_normal(hit.triangle, hit.barycentric);
-    let sample = model.sample(n, wo, u)?;
-    let mut face = scene.face_normal(hit.triangle);
-    if face.dot(wo) < 0.0 {
-        face = -face;
-    }
-    if face.dot(sample.wi) <= 0.0 {
-        return None;
-    }
-    Some((p + face * surface_offset(p), sample))
+    Some((water.start, water.reflect(model, u)?))
 }
 
 fn reflected_ray(

@@ -116,6 +116,11 @@ pub enum EdgeStatus {
     Unconstrained {
         /// Why, for a person.
         reason: String,
+        /// No pixel of the streak's edge looks at this edge at all (rather than a few, or
+        /// ones cut by the photo's border): it was placed at the lobes' farthest reach, and
+        /// the joint refinement keeps it there instead of letting it trade against the
+        /// others.
+        unseen: bool,
     },
 }
 

@@ -257,6 +257,7 @@ fn solve(
                         "only {valid} streak-edge pixels constrain the light's {} edge",
                         side.name()
                     ),
+                    unseen: valid == 0,
                 }
             } else if truncated as f32 > MAX_TRUNCATED_FRACTION * pixels.len() as f32 {
                 EdgeStatus::Unconstrained {
@@ -267,6 +268,7 @@ fn solve(
                         side.name(),
                         pixels.len()
                     ),
+                    unseen: false,
                 }
             } else {
                 EdgeStatus::Constrained { pixels: valid }
