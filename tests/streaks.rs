@@ -159,6 +159,108 @@ fn table3_yellow_lights_give_two_streaks_left_to_right() {
     }
 }
 
+/// Mean V (sRGB-encoded, as displayed) of the photo over a box.
+fn mean_display_value(photo: &Photo, b: &BoundingBox) -> f32 {
+    let mut sum = 0.0;
+    let mut n = 0;
+    for y in b.y_min..=b.y_max {
+        for x in b.x_min..=b.x_max {
+            let p = photo.display[photo.index(x, y)];
+            sum += p[0].max(p[1]).max(p[2]);
+            n += 1;
+        }
+    }
+    sum / n as f32
+}
+
+#[test]
+fn stacked_lights_overlap_into_one_streak_with_both_parts_visible() {
+    let photo = sample_photo("stacked.png");
+    let seg = segment(&photo);
+    let boxes: Vec<BoundingBox> = seg.streaks.iter().map(|s| s.bbox).collect();
+    // One streak: the two reflections are not told apart by the segmentation, which is
+    // what makes this the overlapping case.
+    assert_eq!(seg.streaks.len(), 1, "streak boxes: {boxes:?}");
+    let streak = &seg.streaks[0];
+    let lights = samples::stacked_lights();
+    for light in &lights {
+        let region = reflection_box(light);
+        // The streak covers each light's flat-water reflection...
+        assert!(
+            streak.bbox.x_min <= region.x_min + 5
+                && streak.bbox.x_max + 5 >= region.x_max
+                && streak.bbox.y_min <= region.y_min
+                && streak.bbox.y_max >= region.y_max,
+            "{:?} does not cover {} at {region:?}",
+            streak.bbox,
+            light.name
+        );
+        // ... and each part is clearly visible: the dark water around is near 0.
+        let value = mean_display_value(&photo, &region);
+        assert!(value > 0.2, "{}: mean V {value} in {region:?}", light.name);
+    }
+    // The two reflections do not touch on flat water; the ripples make them one streak.
+    let (lower, upper) = (reflection_box(&lights[0]), reflection_box(&lights[1]));
+    assert!(lower.y_max < upper.y_min, "{lower:?} {upper:?}");
+    assert!(streak.pixels.len() > 1000);
+    let c = streak.mean_colour;
+    let (max, min) = (c[0].max(c[1]).max(c[2]), c[0].min(c[1]).min(c[2]));
+    assert!(min > 0.9 * max, "{c:?}");
+}
+
+#[test]
+fn table1_light_over_rough_water_gives_one_streak() {
+    let (_, photo) = samples::gloss_sample_files(samples::SAMPLE_GLOSSES[0]);
+    assert_eq!(photo, "gloss200.png");
+    let seg = segment(&sample_photo(&photo));
+    let boxes: Vec<BoundingBox> = seg.streaks.iter().map(|s| s.bbox).collect();
+    assert_eq!(seg.streaks.len(), 1, "streak boxes: {boxes:?}");
+    let streak = &seg.streaks[0];
+    let region = reflection_box(&samples::table1_light());
+    assert!(
+        streak.bbox.overlaps(&region),
+        "{:?} vs {region:?}",
+        streak.bbox
+    );
+    // Rougher water spreads the reflection wider than at e = 500 (check_matches allows 60
+    // pixels around the flat-water image; here 100).
+    let inside = streak
+        .pixels
+        .iter()
+        .filter(|&&p| contains(&grown(region, 100), (p % 600, p / 600)))
+        .count();
+    assert!(inside as f64 >= 0.9 * streak.pixels.len() as f64);
+    assert!(streak.pixels.len() > 1000);
+}
+
+/// The streaks of the smooth-water sample lie on the light's reflection; how many there are
+/// is the ignored test below.
+#[test]
+fn table1_light_over_smooth_water_gives_streaks_only_on_its_reflection() {
+    let (_, photo) = samples::gloss_sample_files(samples::SAMPLE_GLOSSES[1]);
+    assert_eq!(photo, "gloss1000.png");
+    let seg = segment(&sample_photo(&photo));
+    assert!(!seg.streaks.is_empty());
+    let region = grown(reflection_box(&samples::table1_light()), 60);
+    for s in &seg.streaks {
+        let inside = s
+            .pixels
+            .iter()
+            .filter(|&&p| contains(&region, (p % 600, p / 600)))
+            .count();
+        assert!(inside as f64 >= 0.9 * s.pixels.len() as f64, "{:?}", s.bbox);
+    }
+}
+
+#[test]
+#[ignore = "the default segmentation splits gloss1000.png in two: a band of brighter ripples \
+            (columns 97-264, rows 380-421, 4217 pixels) grows from its own seed inside the \
+            main streak (columns 61-272, rows 330-599); with render seed 2 it is one streak"]
+fn table1_light_over_smooth_water_gives_one_streak() {
+    let seg = segment(&sample_photo("gloss1000.png"));
+    check_matches(&seg, &[samples::table1_light()]);
+}
+
 #[test]
 fn a_photo_without_lights_gives_no_streak_and_says_why() {
     let seg = segment(&sample_photo("dark.png"));

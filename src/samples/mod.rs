@@ -4,6 +4,13 @@
 //! z = 0 (or moved, for Table 2); a rippled water height field in front of it. The shared
 //! water mesh is large (about 12 MB), so it is generated rather than committed; the
 //! scenes are small JSON files and the photos small PNGs.
+//!
+//! Besides the paper's Tables 1 to 3, truth scenes with photos for cases the paper does not
+//! show: Table 1's light over rougher and smoother water ([`SAMPLE_GLOSSES`]:
+//! `gloss200.png`, `gloss1000.png`), and two lights one above the other whose reflections
+//! overlap into a single streak ([`stacked_lights`]: `stacked.png`). `table1.exr` is
+//! Table 1's photo as linear float, from the same render as `table1.png` (large, so not
+//! committed).
 
 pub mod water_surface;
 
@@ -32,6 +39,12 @@ pub const PHOTO_EXPOSURE: f32 = 0.1;
 pub const PHOTO_SPP: u32 = 256;
 /// File name of the generated water mesh.
 pub const WATER_BIN: &str = "water.bin";
+/// Gloss (Phong exponent e) of the samples' water, unless a scene says otherwise.
+pub const DEFAULT_GLOSS: f64 = 500.0;
+/// Water gloss of the gloss samples `gloss200-truth.gltf` (`gloss200.png`) and
+/// `gloss1000-truth.gltf` (`gloss1000.png`): Table 1's light over rougher and smoother water
+/// than the other samples' [`DEFAULT_GLOSS`].
+pub const SAMPLE_GLOSSES: [f64; 2] = [200.0, 1000.0];
 
 /// A rectangle light on the wall, as the paper's tables give it.
 #[derive(Clone, Debug)]
@@ -78,8 +91,11 @@ pub struct SampleScene {
     pub gloss: f64,
     /// Lights (truth scenes only).
     pub lights: Vec<SampleLight>,
-    /// Photo rendered from this scene, if any.
+    /// Photo rendered from this scene, if any (8-bit sRGB PNG).
     pub photo: Option<String>,
+    /// The same render written as linear float OpenEXR too, if any (radiance times the
+    /// exposure, unclipped).
+    pub photo_exr: Option<String>,
 }
 
 /// Table 1's light (corner (-4, 2, 0), 3 x 3, L = 20).
@@ -95,6 +111,36 @@ pub fn table3_lights() -> Vec<SampleLight> {
     ]
 }
 
+/// The stacked sample's two white lights, one above the other on the wall z = 0 with the
+/// same horizontal span and a gap of 0.8 m between them: lower corner (-2, 1.2, 0), 3 x 1.0,
+/// L = 16; upper corner (-2, 3, 0), 3 x 1.4, L = 14. The ripples stretch each reflection
+/// over most of the other's, so on the water they make one streak: the lower light's
+/// reflection is its brighter part, next to the horizon, the upper light's its dimmer part,
+/// nearer the camera.
+pub fn stacked_lights() -> Vec<SampleLight> {
+    vec![
+        SampleLight::new("lower", [-2.0, 1.2, 0.0], [3.0, 1.0], [16.0; 3]),
+        SampleLight::new("upper", [-2.0, 3.0, 0.0], [3.0, 1.4], [14.0; 3]),
+    ]
+}
+
+/// The truth scene and photo file names of the gloss sample with water gloss `gloss`
+/// (one of [`SAMPLE_GLOSSES`]): `("gloss200-truth.gltf", "gloss200.png")` for e = 200.
+pub fn gloss_sample_files(gloss: f64) -> (String, String) {
+    (
+        format!("gloss{gloss}-truth.gltf"),
+        format!("gloss{gloss}.png"),
+    )
+}
+
+/// The catalogue entry whose photo (PNG or EXR) is named `photo`, if any: its truth lights
+/// and water gloss.
+pub fn by_photo(photo: &str) -> Option<SampleScene> {
+    catalogue()
+        .into_iter()
+        .find(|s| s.photo.as_deref() == Some(photo) || s.photo_exr.as_deref() == Some(photo))
+}
+
 /// Every sample scene.
 pub fn catalogue() -> Vec<SampleScene> {
     let scene = |file: &str,
@@ -106,12 +152,26 @@ pub fn catalogue() -> Vec<SampleScene> {
             file: file.into(),
             description: description.into(),
             wall_z,
-            gloss: 500.0,
+            gloss: DEFAULT_GLOSS,
             lights,
             photo: photo.map(str::to_owned),
+            photo_exr: None,
         }
     };
-    vec![
+    let gloss_samples = SAMPLE_GLOSSES.map(|gloss| {
+        let (file, photo) = gloss_sample_files(gloss);
+        SampleScene {
+            gloss,
+            ..scene(
+                &file,
+                &format!("Table 1's light over water of gloss e = {gloss}"),
+                0.0,
+                vec![table1_light()],
+                Some(&photo),
+            )
+        }
+    });
+    let mut scenes = vec![
         scene(
             "scene.gltf",
             "the paper's setup without lights: the input of a fit",
@@ -125,7 +185,8 @@ pub fn catalogue() -> Vec<SampleScene> {
             0.0,
             vec![table1_light()],
             Some("table1.png"),
-        ),
+        )
+        .with_exr("table1.exr"),
         scene(
             "table3-truth.gltf",
             "Table 3: lights (-4, 2, 0) 3 x 3 L = (20, 20, 0) and (5, 2, 0) 2 x 2 L = (10, 10, 0)",
@@ -147,7 +208,25 @@ pub fn catalogue() -> Vec<SampleScene> {
             vec![],
             None,
         ),
-    ]
+    ];
+    scenes.extend(gloss_samples);
+    scenes.push(scene(
+        "stacked-truth.gltf",
+        "two white lights one above the other, (-2, 1.2, 0) 3 x 1 L = 16 and (-2, 3, 0) 3 x 1.4 L = 14: their reflections overlap into one streak",
+        0.0,
+        stacked_lights(),
+        Some("stacked.png"),
+    ));
+    scenes
+}
+
+impl SampleScene {
+    fn with_exr(self, exr: &str) -> Self {
+        SampleScene {
+            photo_exr: Some(exr.into()),
+            ..self
+        }
+    }
 }
 
 /// The water grid of every sample.
@@ -358,6 +437,11 @@ pub fn render_photos(dir: &Path, spp: u32, progress: bool) -> Result<Vec<PathBuf
         let path = dir.join(photo);
         crate::photo_out::write(&path, image.width, image.height, &image.pixels)?;
         written.push(path);
+        if let Some(exr) = &spec.photo_exr {
+            let path = dir.join(exr);
+            crate::photo_out::write(&path, image.width, image.height, &image.pixels)?;
+            written.push(path);
+        }
     }
     Ok(written)
 }
