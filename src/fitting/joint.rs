@@ -78,7 +78,7 @@ impl JointOptions {
 }
 
 /// Default lobe samples per pixel of the joint fit.
-pub const DEFAULT_JOINT_SAMPLES: u32 = 96;
+pub const DEFAULT_JOINT_SAMPLES: u32 = 128;
 
 /// One-sigma uncertainties of a light's parameters.
 #[derive(Clone, Debug, PartialEq)]
@@ -273,7 +273,7 @@ fn sees_region_of_interest(
     })
 }
 
-/// Camera rays per side of a pixel's stratification grid: 4 x 4 jittered camera rays cover
+/// Camera rays per side of a pixel's stratification grid: 2 x 2 jittered camera rays cover
 /// the footprint evenly, and the lobe is sampled several times from each.
 const CAMERA_STRATA: u32 = 2;
 
