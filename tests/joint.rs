@@ -196,7 +196,12 @@ fn dev_from_truth_t3() {
         start[k].radiance = truth.radiance.map(|c| c as f32);
     }
     let mut jo = JointOptions::new(options.model, 1);
-    let env = |k: &str, d: u32| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    let env = |k: &str, d: u32| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
     jo.samples = env("DEV_SAMPLES", 128);
     jo.sweeps = env("DEV_SWEEPS", 14);
     jo.checkerboard = env("DEV_CHECKER", 1) == 1;
@@ -294,7 +299,10 @@ fn dev_dump_truth_t1() {
     jo.margin = 20;
     jo.checkerboard = false;
     let j0 = fit_joint(&scene, &photo, &water, &streaks, &start, &jo).unwrap();
-    eprintln!("L {:?} sigma2 {:.4e}", j0.lights[0].radiance, j0.residual_variance);
+    eprintln!(
+        "L {:?} sigma2 {:.4e}",
+        j0.lights[0].radiance, j0.residual_variance
+    );
 }
 
 #[test]
@@ -306,7 +314,12 @@ fn dev_configs_t1() {
     let streaks = threshold_streaks(&photo, &water, STREAK_THRESHOLD, 200);
     let options = FitOptions::for_scene(&scene);
     let paper = fit_paper(&scene, &photo, &water, &streaks, &options).unwrap();
-    let env = |k: &str, d: u32| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    let env = |k: &str, d: u32| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
     let mut jo = JointOptions::new(options.model, 1);
     jo.samples = env("DEV_SAMPLES", 96);
     jo.margin = env("DEV_MARGIN", 6);
@@ -314,10 +327,33 @@ fn dev_configs_t1() {
     jo.sweeps = env("DEV_SWEEPS", 14);
     let t = std::time::Instant::now();
     let j = fit_joint(&scene, &photo, &water, &streaks, &paper.lights, &jo).unwrap();
-    let truths = if photo.width > 0 && std::env::var("DEV_PHOTO").map(|p| p.contains("table3")).unwrap_or(false) { samples::table3_lights() } else { vec![samples::table1_light()] };
-    for (k, truth) in truths.iter().enumerate() {
-        let (e, r) = errors(&j.lights[k], truth, scene.origin);
-        eprintln!("light{k}: edges % {:?} rad {r:.4} sigma2 {:.4e} pixels {} {:?} total {:.2}", e.map(|e| (e * 1e4).round() / 1e2), j.residual_variance, j.pixels, j.timings, t.elapsed().as_secs_f64());
+    let name = std::env::var("DEV_PHOTO").unwrap_or_default();
+    let truths = if name.contains("table3") {
+        samples::table3_lights()
+    } else if name.contains("stacked") {
+        samples::stacked_lights()
+    } else {
+        vec![samples::table1_light()]
+    };
+    eprintln!(
+        "paper: {} lights, joint: {} lights",
+        paper.lights.len(),
+        j.lights.len()
+    );
+    let mut lights = j.lights.clone();
+    if name.contains("stacked") {
+        lights.sort_by(|a, b| a.v_min.total_cmp(&b.v_min));
+    }
+    for (k, truth) in truths.iter().enumerate().take(lights.len()) {
+        let (e, r) = errors(&lights[k], truth, scene.origin);
+        eprintln!(
+            "light{k}: edges % {:?} rad {r:.4} sigma2 {:.4e} pixels {} {:?} total {:.2}",
+            e.map(|e| (e * 1e4).round() / 1e2),
+            j.residual_variance,
+            j.pixels,
+            j.timings,
+            t.elapsed().as_secs_f64()
+        );
         eprintln!("   unc {:?}", j.uncertainty[k]);
     }
 }

@@ -61,6 +61,9 @@ pub struct JointOptions {
     /// Fit every pixel (false) or a checkerboard half of them (true): neighbouring pixels
     /// carry nearly the same information, and the footprints are most of the cost.
     pub checkerboard: bool,
+    /// Try explaining each light as two (overlapping streaks), keeping the split when it
+    /// fits the photo far better.
+    pub split: bool,
 }
 
 impl JointOptions {
@@ -73,6 +76,7 @@ impl JointOptions {
             margin: 6,
             sweeps: 14,
             checkerboard: true,
+            split: true,
         }
     }
 }
@@ -121,41 +125,39 @@ impl PlaneSamples {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
     }
 
-    /// `(c, var(c))`: the coefficient and the variance of its estimate.
+    /// `(c, d)`: the coefficient and its half-difference (see the note on the coefficients' noise).
     fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> (f32, f32) {
         let r = self.range(i);
-        let (mut sum, mut half_difference) = (0f32, 0f32);
+        let (mut sum, mut signed) = (0f32, 0f32);
         for (p, &w) in self.points[r.clone()].iter().zip(&self.weights[r]) {
             if rect.contains(*p) {
                 sum += w.abs();
-                half_difference += w;
+                signed += w;
             }
         }
-        (
-            sum * inv_samples,
-            estimate_variance(half_difference, inv_samples),
-        )
+        (sum * inv_samples, signed * inv_samples)
     }
 }
 
-/// Variance of a coefficient estimated from two independent halves of its samples, given
-/// the halves' difference of weight sums (`inv_n` = 1 / all samples): with A and B the two
-/// half estimates, the coefficient is (A + B) / 2 and (A - B)^2 / 4 estimates its variance
-/// without bias, whatever the stratification inside each half.
-///
-/// Why it matters: the coefficients are themselves Monte Carlo estimates, and least squares
-/// with a noisy regressor is biased (sum c_hat^2 overestimates sum c^2 by the summed
-/// variance, pulling the radiance low and pushing the edges to compensate; the weakly seen
-/// edges move by a percent). Subtracting the estimated variance from the normal equations
-/// removes that bias. The textbook estimate from the spread of individual samples would
-/// assume independent samples, and overestimate the variance of stratified ones.
-fn estimate_variance(half_difference: f32, inv_n: f32) -> f32 {
-    let d = half_difference * inv_n;
-    d * d
-}
+// The noise of the coefficients, and why the fit must remove it.
+//
+// The coefficients are Monte Carlo estimates, and least squares with a noisy regressor is
+// biased: sum c_hat^2 overestimates sum c^2 by the summed variance, which pulls the radiance
+// low and pushes the edges to compensate (the weakly seen edges move by a percent). Each
+// pixel's samples are two independent halves, A and B (the sign of a stored weight says
+// which); the coefficient is (A + B) / 2 and `d = (A - B) / 2`, its half-difference, has
+// E[d^2] = var(c_hat) whatever the stratification inside each half. More: for the modelled
+// pixel m = sum_k L_k c_k, E[(sum_k L_k d_k)^2] = var(m_hat) including the covariances of
+// lights that share samples (two pieces of one rectangle are strongly anti-correlated:
+// subtracting their variances one by one would reward splitting a light in two). So the fit
+// minimises sum (I - m_hat)^2 - (sum_k L_k d_k)^2, an unbiased estimate of the noise-free
+// cost up to a constant, and its normal equations carry `c_a c_b - d_a d_b`.
 
 /// The fitting problem: observed pixels and every light's stored samples.
 struct Problem {
+    /// Photo width, to tell a fitted pixel's row.
+    width: u32,
+    /// Photo pixel index of every fitted pixel.
     pixel_ids: Vec<u32>,
     obs: Vec<[f32; 3]>,
     clipped: Vec<bool>,
@@ -316,9 +318,16 @@ fn trace_samples(
             let mut hits = Vec::new();
             let inv_c = 1.0 / CAMERA_STRATA as f32;
             let inv_l = 1.0 / lobe as f32;
-            for (cs, half_sign) in (0..2 * CAMERA_STRATA * CAMERA_STRATA)
-                .map(|i| (i % (CAMERA_STRATA * CAMERA_STRATA), if i < CAMERA_STRATA * CAMERA_STRATA { 1.0 } else { -1.0 }))
-            {
+            for (cs, half_sign) in (0..2 * CAMERA_STRATA * CAMERA_STRATA).map(|i| {
+                (
+                    i % (CAMERA_STRATA * CAMERA_STRATA),
+                    if i < CAMERA_STRATA * CAMERA_STRATA {
+                        1.0
+                    } else {
+                        -1.0
+                    },
+                )
+            }) {
                 let fx = ((cs % CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
                 let fy = ((cs / CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
                 let CameraHit::Water(water) =
@@ -503,13 +512,19 @@ fn invert(m: &[f64], n: usize) -> Option<Vec<f64>> {
     Some(inv)
 }
 
+#[derive(Clone)]
 struct State {
+    /// Per light, which stored sample set (plane) it reads: lights split from one start
+    /// share their plane's samples.
+    set_of: Vec<usize>,
+    /// Per light and edge: held where it is (an edge no pixel looks at).
+    pinned: Vec<[bool; 4]>,
     rects: Vec<Rect>,
     radiance: Vec<[f64; 3]>,
     /// `coef[k][i]`: light k's coefficient at fitted pixel i with the current rectangle.
     coef: Vec<Vec<f32>>,
-    /// `var[k][i]`: the variance of that estimate.
-    var: Vec<Vec<f32>>,
+    /// `dev[k][i]`: that estimate's half-difference (see the note on the coefficients' noise).
+    dev: Vec<Vec<f32>>,
 }
 
 impl Problem {
@@ -517,18 +532,37 @@ impl Problem {
         self.obs.len()
     }
 
-    fn coefficients(&self, k: usize, rect: &Rect) -> (Vec<f32>, Vec<f32>) {
+    fn coefficients(&self, set: usize, rect: &Rect) -> (Vec<f32>, Vec<f32>) {
         (0..self.n())
             .into_par_iter()
-            .map(|i| self.planes[k].coefficient(i, rect, self.inv_samples))
+            .map(|i| self.planes[set].coefficient(i, rect, self.inv_samples))
             .unzip()
     }
 
+    /// Moves light k to `rect`, recomputing only the coefficients of pixels with a sample
+    /// where the old and the new rectangle differ (a one-edge move touches a thin strip).
     fn set_rect(&self, st: &mut State, k: usize, rect: Rect) {
+        let old = st.rects[k];
         st.rects[k] = rect;
-        let (c, v) = self.coefficients(k, &rect);
-        st.coef[k] = c;
-        st.var[k] = v;
+        let samples = &self.planes[st.set_of[k]];
+        let strip = changed_strip(&old, &rect);
+        let inv = self.inv_samples;
+        st.coef[k]
+            .par_iter_mut()
+            .zip(st.dev[k].par_iter_mut())
+            .enumerate()
+            .for_each(|(i, (c, v))| {
+                let bb = &samples.bbox[i];
+                let touched = strip.is_none_or(|s| {
+                    bb.u_max >= s.u_min
+                        && bb.u_min <= s.u_max
+                        && bb.v_max >= s.v_min
+                        && bb.v_min <= s.v_max
+                });
+                if touched {
+                    (*c, *v) = samples.coefficient(i, &rect, inv);
+                }
+            });
     }
 
     fn model(&self, st: &State, i: usize) -> [f64; 3] {
@@ -554,18 +588,63 @@ impl Problem {
                             0.0
                         } else {
                             // Less the part of r^2 that is the coefficients' own noise.
-                            let noise: f64 = st
+                            let d: f64 = st
                                 .radiance
                                 .iter()
                                 .enumerate()
-                                .map(|(k, l)| l[c] * l[c] * st.var[k][i] as f64)
+                                .map(|(k, l)| l[c] * st.dev[k][i] as f64)
                                 .sum();
-                            r * r - noise
+                            r * r - d * d
                         }
                     })
                     .sum::<f64>()
             })
             .sum()
+    }
+
+    /// The plain residual sum of squares (no noise removed; clipped pixels one-sided).
+    fn raw_cost(&self, st: &State) -> f64 {
+        (0..self.n())
+            .map(|i| {
+                let m = self.model(st, i);
+                (0..3)
+                    .map(|c| {
+                        let r = self.obs[i][c] as f64 - m[c];
+                        if self.clipped[i] && r < 0.0 {
+                            0.0
+                        } else {
+                            r * r
+                        }
+                    })
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// Whether the residual is structured along rows: for noise independent from pixel to
+    /// pixel the row-summed cost is about the plain one, a light missing from the model
+    /// makes it many times larger (Table 1's fit: 1.05; two stacked lights fitted as one:
+    /// 15).
+    fn structured(&self, st: &State) -> bool {
+        self.row_cost(st) > SPLIT_STRUCTURE_RATIO * self.raw_cost(st)
+    }
+
+    /// The residual summed over each image row, squared and summed: a misfit that persists
+    /// along rows (one light where there are two) grows with the row's pixel count squared,
+    /// the noise only with the count, so the comparison is not at the noise's mercy.
+    fn row_cost(&self, st: &State) -> f64 {
+        let mut rows: std::collections::BTreeMap<u32, [f64; 3]> = Default::default();
+        for i in 0..self.n() {
+            if self.clipped[i] {
+                continue;
+            }
+            let m = self.model(st, i);
+            let row = rows.entry(self.pixel_ids[i] / self.width).or_default();
+            for c in 0..3 {
+                row[c] += self.obs[i][c] as f64 - m[c];
+            }
+        }
+        rows.values().flatten().map(|r| r * r).sum()
     }
 
     /// Re-solves every radiance given the rectangles: per channel, nonnegative least squares
@@ -585,10 +664,10 @@ impl Problem {
                             continue;
                         }
                         atb[a] += ca * self.obs[i][ch] as f64;
+                        let da = st.dev[a][i] as f64;
                         for b in 0..k {
-                            ata[a * k + b] += ca * st.coef[b][i] as f64;
+                            ata[a * k + b] += ca * st.coef[b][i] as f64 - da * st.dev[b][i] as f64;
                         }
-                        ata[a * k + a] -= st.var[a][i] as f64;
                         raw_diag[a] += ca * ca;
                     }
                 }
@@ -616,6 +695,21 @@ impl Problem {
         }
     }
 
+    /// At pixel i, the other lights' model and their combined half-difference, per channel.
+    fn others(&self, st: &State, k: usize, i: usize) -> ([f64; 3], [f64; 3]) {
+        let (mut rest, mut rest_dev) = ([0f64; 3], [0f64; 3]);
+        for (kk, l) in st.radiance.iter().enumerate() {
+            if kk != k {
+                let (c, d) = (st.coef[kk][i] as f64, st.dev[kk][i] as f64);
+                for ch in 0..3 {
+                    rest[ch] += l[ch] * c;
+                    rest_dev[ch] += l[ch] * d;
+                }
+            }
+        }
+        (rest, rest_dev)
+    }
+
     /// The sums of [`Problem::edge_profile`] over the fitted pixels `chunk`.
     #[allow(clippy::too_many_arguments)]
     fn profile_sums(
@@ -629,7 +723,7 @@ impl Problem {
         chunk: &[usize],
     ) -> ProfileSums {
         let rect = st.rects[k];
-        let plane = &self.planes[k];
+        let plane = &self.planes[st.set_of[k]];
         let mut a = vec![0f64; grid];
         let mut a_raw = vec![0f64; grid];
         let mut b = vec![[0f64; 3]; grid];
@@ -653,20 +747,13 @@ impl Problem {
                 // every grid point, so there is nothing to bin.
                 let c = st.coef[k][i] as f64;
                 if c != 0.0 {
-                    let var = st.var[k][i] as f64;
-                    let mut rest = [0f64; 3];
-                    for (kk, l) in st.radiance.iter().enumerate() {
-                        if kk != k {
-                            for ch in 0..3 {
-                                rest[ch] += l[ch] * st.coef[kk][i] as f64;
-                            }
-                        }
-                    }
+                    let d = st.dev[k][i] as f64;
+                    let (rest, rest_dev) = self.others(st, k, i);
                     for j in 0..grid {
                         a_raw[j] += c * c;
-                        a[j] += c * c - var;
+                        a[j] += c * c - d * d;
                         for ch in 0..3 {
-                            b[j][ch] += c * (self.obs[i][ch] as f64 - rest[ch]);
+                            b[j][ch] += c * (self.obs[i][ch] as f64 - rest[ch]) + d * rest_dev[ch];
                         }
                     }
                 }
@@ -737,15 +824,7 @@ impl Problem {
                     }
                 }
             }
-            let mut rest = [0f64; 3];
-            for (kk, l) in st.radiance.iter().enumerate() {
-                if kk != k {
-                    let c = st.coef[kk][i] as f64;
-                    for ch in 0..3 {
-                        rest[ch] += l[ch] * c;
-                    }
-                }
-            }
+            let (rest, rest_dev) = self.others(st, k, i);
             let res = [0, 1, 2].map(|ch| self.obs[i][ch] as f64 - rest[ch]);
             if self.clipped[i] {
                 clipped_rows.push((i, cvals.iter().map(|c| c * self.inv_samples).collect()));
@@ -755,9 +834,10 @@ impl Problem {
                 let cf = cvals[j] * self.inv_samples;
                 let c = cf as f64;
                 a_raw[j] += c * c;
-                a[j] += c * c - estimate_variance(half_difference[j], self.inv_samples) as f64;
+                let d = (half_difference[j] * self.inv_samples) as f64;
+                a[j] += c * c - d * d;
                 for ch in 0..3 {
-                    b[j][ch] += c * res[ch];
+                    b[j][ch] += c * res[ch] + d * rest_dev[ch];
                 }
             }
         }
@@ -842,6 +922,56 @@ impl Problem {
                 (cost, l)
             })
             .collect()
+    }
+}
+
+/// The region where two rectangles differing in one edge differ; `None` when they differ in
+/// more (then every coefficient is recomputed).
+fn changed_strip(a: &Rect, b: &Rect) -> Option<Rect> {
+    let du = (a.u_min != b.u_min, a.u_max != b.u_max);
+    let dv = (a.v_min != b.v_min, a.v_max != b.v_max);
+    let changed = [du.0, du.1, dv.0, dv.1].iter().filter(|&&d| d).count();
+    match changed {
+        0 => Some(Rect {
+            u_min: f32::INFINITY,
+            u_max: f32::NEG_INFINITY,
+            v_min: f32::INFINITY,
+            v_max: f32::NEG_INFINITY,
+        }),
+        1 => {
+            let (lo_u, hi_u) = (a.u_min.min(b.u_min), a.u_max.max(b.u_max));
+            let (lo_v, hi_v) = (a.v_min.min(b.v_min), a.v_max.max(b.v_max));
+            Some(if du.0 {
+                Rect {
+                    u_min: lo_u,
+                    u_max: a.u_min.max(b.u_min),
+                    v_min: lo_v,
+                    v_max: hi_v,
+                }
+            } else if du.1 {
+                Rect {
+                    u_min: a.u_max.min(b.u_max),
+                    u_max: hi_u,
+                    v_min: lo_v,
+                    v_max: hi_v,
+                }
+            } else if dv.0 {
+                Rect {
+                    u_min: lo_u,
+                    u_max: hi_u,
+                    v_min: lo_v,
+                    v_max: a.v_min.max(b.v_min),
+                }
+            } else {
+                Rect {
+                    u_min: lo_u,
+                    u_max: hi_u,
+                    v_min: a.v_max.min(b.v_max),
+                    v_max: hi_v,
+                }
+            })
+        }
+        _ => None,
     }
 }
 
@@ -942,7 +1072,10 @@ pub fn fit_joint(
     }
     let t0 = Instant::now();
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
-    let roi: Vec<Rect> = start.iter().map(|l| region_of_interest(&l.rect())).collect();
+    let roi: Vec<Rect> = start
+        .iter()
+        .map(|l| region_of_interest(&l.rect()))
+        .collect();
     let pixels = region(
         scene,
         &options.model,
@@ -968,13 +1101,14 @@ pub fn fit_joint(
     let footprint_seconds = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let problem = Problem {
+        width: photo.width,
         pixel_ids: pixels.clone(),
         obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
         clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
         planes: stored,
         inv_samples: 1.0 / per_pixel_samples as f32,
     };
-    let (lights, uncertainty, variance) = optimise(&problem, start, options.sweeps);
+    let (lights, uncertainty, variance) = optimise(&problem, start, options.sweeps, options.split);
     Ok(JointOutcome {
         lights,
         uncertainty,
@@ -987,122 +1121,241 @@ pub fn fit_joint(
     })
 }
 
+/// A light's rectangle clamped into the region its samples can see (an unconstrained edge
+/// of the paper fit may sit far beyond it).
+fn clamp_to(r: Rect, extent: Option<Rect>) -> Rect {
+    match extent {
+        Some(e) => {
+            let u_min = r.u_min.clamp(e.u_min, e.u_max);
+            let v_min = r.v_min.clamp(e.v_min, e.v_max);
+            Rect {
+                u_min,
+                u_max: r.u_max.clamp(u_min, e.u_max),
+                v_min,
+                v_max: r.v_max.clamp(v_min, e.v_max),
+            }
+        }
+        None => r,
+    }
+}
+
+impl Problem {
+    /// A state with these lights, their coefficients computed and radiances solved.
+    fn state(
+        &self,
+        set_of: Vec<usize>,
+        pinned: Vec<[bool; 4]>,
+        rects: Vec<Rect>,
+        radiance: Vec<[f64; 3]>,
+    ) -> State {
+        let (coef, dev) = rects
+            .iter()
+            .zip(&set_of)
+            .map(|(r, &set)| self.coefficients(set, r))
+            .unzip();
+        let mut st = State {
+            set_of,
+            pinned,
+            rects,
+            radiance,
+            coef,
+            dev,
+        };
+        self.solve_radiance(&mut st);
+        st
+    }
+
+    /// Coordinate descent over every free edge (see the module doc) for at most `sweeps`
+    /// sweeps, stopping early once every search window has shrunk to its minimum.
+    fn descend(&self, st: &mut State, extents: &[Option<Rect>], sweeps: u32) {
+        // Initial half-windows: see `first_window`.
+        let mut windows: Vec<[f32; 4]> = st.rects.iter().map(|r| [first_window(r); 4]).collect();
+        for _sweep in 0..sweeps {
+            for k in 0..st.rects.len() {
+                let Some(ext) = extents[st.set_of[k]] else {
+                    continue;
+                };
+                for side in EdgeSide::ALL {
+                    if st.pinned[k][side as usize] {
+                        windows[k][side as usize] = 0.0;
+                        continue;
+                    }
+                    let half = windows[k][side as usize];
+                    let cur = st.rects[k].edge(side);
+                    let (lo, hi) = edge_bounds(&st.rects[k], side, &ext);
+                    let a = (cur - half).max(lo);
+                    let b = (cur + half).min(hi);
+                    if b <= a {
+                        windows[k][side as usize] = MIN_WINDOW;
+                        continue;
+                    }
+                    let step = (b - a) / (GRID - 1) as f32;
+                    let prof = self.edge_profile(st, k, side, a, step, GRID);
+                    let cur_j = ((cur - a) / step).round().clamp(0.0, (GRID - 1) as f32) as usize;
+                    // Prefer the current position on ties (flat cost: an unconstrained edge).
+                    let mut best = cur_j;
+                    for (j, p) in prof.iter().enumerate() {
+                        if p.0 < prof[best].0 - 1e-12 * prof[best].0.abs().max(1e-30) {
+                            best = j;
+                        }
+                    }
+                    let t = if best == cur_j {
+                        cur
+                    } else {
+                        a + best as f32 * step
+                    };
+                    let moved_rect = st.rects[k].with_edge(side, t);
+                    self.set_rect(st, k, moved_rect);
+                    st.radiance[k] = prof[best].1;
+                    // Shrink the window, but never below a few times the last move: an edge
+                    // coupled to others (top and bottom trade against the radiance) keeps
+                    // travelling for several sweeps, and a window that shrank regardless
+                    // would freeze it short of the optimum.
+                    let moved = (t - cur).abs();
+                    windows[k][side as usize] =
+                        (half * 0.5).max(4.0 * moved).min(half).max(MIN_WINDOW);
+                }
+            }
+            self.solve_radiance(st);
+            if windows.iter().flatten().all(|&w| w <= MIN_WINDOW) {
+                break;
+            }
+        }
+    }
+}
+
+/// Row-summed over plain cost above which a residual counts as structured and a split is
+/// tried (see [`Problem::structured`]).
+const SPLIT_STRUCTURE_RATIO: f64 = 3.0;
+
+/// Sweeps of the coarse fit that decides whether splitting a light pays.
+const SPLIT_TRIAL_SWEEPS: u32 = 8;
+
+/// A split is kept when it at least halves the row-summed residual ([`Problem::row_cost`]).
+/// Measured: two stacked lights fitted as one leave 7x the row cost of the split, a single
+/// light split in two gains nothing (its row cost rises by a few percent). The per-pixel
+/// cost cannot decide this: with the coefficients' noise removed it rewards any extra
+/// freedom to place edges where that noise happens to be large.
+const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
+
+/// Tries to explain light k as two lights on its plane, side by side or one above the other
+/// (overlapping streaks merge into one region, METHOD §5 and the paper's §5.3): each
+/// candidate starts from the rectangle cut in half and is fitted coarsely. Returns the best
+/// candidate state and its cost when it beats `cost` by more than [`SPLIT_MIN_CHI2_DROP`].
+fn try_split(
+    problem: &Problem,
+    st: &State,
+    k: usize,
+    extents: &[Option<Rect>],
+    cost: f64,
+) -> Option<(State, f64)> {
+    let r = st.rects[k];
+    let halves = [
+        // One above the other.
+        (
+            r.with_edge(EdgeSide::Top, 0.5 * (r.v_min + r.v_max)),
+            r.with_edge(EdgeSide::Bottom, 0.5 * (r.v_min + r.v_max)),
+        ),
+        // Side by side.
+        (
+            r.with_edge(EdgeSide::Right, 0.5 * (r.u_min + r.u_max)),
+            r.with_edge(EdgeSide::Left, 0.5 * (r.u_min + r.u_max)),
+        ),
+    ];
+    let mut best: Option<(State, f64)> = None;
+    for (first, second) in halves {
+        let mut set_of = st.set_of.clone();
+        let mut pinned = st.pinned.clone();
+        let mut rects = st.rects.clone();
+        let mut radiance = st.radiance.clone();
+        rects[k] = first;
+        rects.push(second);
+        set_of.push(st.set_of[k]);
+        pinned.push(st.pinned[k]);
+        radiance.push(st.radiance[k]);
+        let mut trial = problem.state(set_of, pinned, rects, radiance);
+        problem.descend(&mut trial, extents, SPLIT_TRIAL_SWEEPS);
+        let c = problem.cost(&trial);
+        let both_lit = [k, trial.rects.len() - 1]
+            .iter()
+            .all(|&j| trial.radiance[j].iter().any(|&l| l > 0.0));
+        if both_lit && best.as_ref().is_none_or(|(_, b)| c < *b) {
+            best = Some((trial, c));
+        }
+    }
+    let _ = cost;
+    let before = problem.row_cost(st);
+    best.filter(|(trial, _)| problem.row_cost(trial) < SPLIT_MIN_ROW_COST_RATIO * before)
+}
+
 fn optimise(
     problem: &Problem,
     start: &[FittedLight],
     sweeps: u32,
+    split: bool,
 ) -> (Vec<FittedLight>, Vec<Uncertainty>, f64) {
-    let k_count = start.len();
     let extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
-    // Start rectangles, clamped into the region the samples can see (an unconstrained edge of
-    // the paper fit may sit far beyond it).
-    let rects: Vec<Rect> = start
-        .iter()
-        .zip(&extents)
-        .map(|(l, e)| {
-            let r = l.rect();
-            match e {
-                Some(e) => {
-                    let u_min = r.u_min.clamp(e.u_min, e.u_max);
-                    let v_min = r.v_min.clamp(e.v_min, e.v_max);
-                    Rect {
-                        u_min,
-                        u_max: r.u_max.clamp(u_min, e.u_max),
-                        v_min,
-                        v_max: r.v_max.clamp(v_min, e.v_max),
-                    }
-                }
-                None => r,
-            }
-        })
-        .collect();
-    let (coef, var): (Vec<Vec<f32>>, Vec<Vec<f32>>) = rects
-        .iter()
-        .enumerate()
-        .map(|(k, r)| problem.coefficients(k, r))
-        .unzip();
-    let mut st = State {
-        coef,
-        var,
-        rects,
-        radiance: start.iter().map(|l| l.radiance.map(f64::from)).collect(),
-    };
-    problem.solve_radiance(&mut st);
-    // Initial half-windows: half the light's size, at least 0.5 m, so an estimate that is a
-    // light's size off is still inside the first grid.
-    let mut windows: Vec<[f32; 4]> = st
-        .rects
-        .iter()
-        .map(|r| [first_window(r); 4])
-        .collect();
-    for _sweep in 0..sweeps {
-        for k in 0..k_count {
-            let Some(ext) = extents[k] else { continue };
-            for side in EdgeSide::ALL {
-                if matches!(
-                    start[k].edges[side as usize],
-                    EdgeStatus::Unconstrained { unseen: true, .. }
-                ) {
-                    continue;
-                }
-                let half = windows[k][side as usize];
-                let cur = st.rects[k].edge(side);
-                let (lo, hi) = edge_bounds(&st.rects[k], side, &ext);
-                let a = (cur - half).max(lo);
-                let b = (cur + half).min(hi);
-                if b <= a {
-                    continue;
-                }
-                let step = (b - a) / (GRID - 1) as f32;
-                let prof = problem.edge_profile(&st, k, side, a, step, GRID);
-                let cur_j = ((cur - a) / step).round().clamp(0.0, (GRID - 1) as f32) as usize;
-                // Prefer the current position on ties (flat cost: an unconstrained edge).
-                let mut best = cur_j;
-                for (j, p) in prof.iter().enumerate() {
-                    if p.0 < prof[best].0 - 1e-12 * prof[best].0.abs().max(1e-30) {
-                        best = j;
-                    }
-                }
-                let t = a + best as f32 * step;
-                let moved_rect = st.rects[k].with_edge(side, t);
-                problem.set_rect(&mut st, k, moved_rect);
-                st.radiance[k] = prof[best].1;
-                // Shrink the window, but never below a few times the last move: an edge
-                // coupled to others (top and bottom trade against the radiance) keeps
-                // travelling for several sweeps, and a window that shrank regardless would
-                // freeze it short of the optimum.
-                let moved = (t - cur).abs();
-                windows[k][side as usize] = (half * 0.5).max(4.0 * moved).min(half).max(MIN_WINDOW);
+    let mut st = problem.state(
+        (0..start.len()).collect(),
+        start
+            .iter()
+            .map(|l| {
+                l.edges
+                    .clone()
+                    .map(|e| matches!(e, EdgeStatus::Unconstrained { unseen: true, .. }))
+            })
+            .collect(),
+        start
+            .iter()
+            .zip(&extents)
+            .map(|(l, e)| clamp_to(l.rect(), *e))
+            .collect(),
+        start.iter().map(|l| l.radiance.map(f64::from)).collect(),
+    );
+    problem.descend(&mut st, &extents, sweeps);
+    let dof = |lights: usize| (problem.n() * 3).saturating_sub(7 * lights).max(1) as f64;
+    let mut cost = problem.cost(&st);
+    if split && problem.structured(&st) {
+        for k in 0..start.len() {
+            if let Some((trial, c)) = try_split(problem, &st, k, &extents, cost) {
+                st = trial;
+                cost = c;
             }
         }
-        problem.solve_radiance(&mut st);
+        if st.rects.len() > start.len() {
+            problem.descend(&mut st, &extents, sweeps);
+            cost = problem.cost(&st);
+        }
     }
     if let Ok(path) = std::env::var("STREAKLIGHT_JOINT_DUMP") {
         let mut out = String::new();
         for i in 0..problem.n() {
             let m = problem.model(&st, i);
-            out += &format!("{} {} {} {}\n", problem.pixel_ids[i], problem.obs[i][0], m[0], problem.clipped[i] as u8);
+            out += &format!(
+                "{} {} {} {}\n",
+                problem.pixel_ids[i], problem.obs[i][0], m[0], problem.clipped[i] as u8
+            );
         }
         let _ = std::fs::write(path, out);
     }
-    let cost = problem.cost(&st);
-    let dof = (problem.n() * 3).saturating_sub(7 * k_count).max(1);
-    let sigma2 = (cost / dof as f64).max(f64::MIN_POSITIVE);
-    let uncertainty = (0..k_count)
+    let sigma2 = (cost / dof(st.rects.len())).max(f64::MIN_POSITIVE);
+    let uncertainty = (0..st.rects.len())
         .map(|k| uncertainty(problem, &st, k, &extents, sigma2))
         .collect();
-    let lights = start
-        .iter()
-        .zip(st.rects.iter().zip(&st.radiance))
-        .map(|(l, (r, rad))| FittedLight {
-            streak_ids: l.streak_ids.clone(),
-            plane: l.plane.clone(),
-            u_min: r.u_min,
-            u_max: r.u_max,
-            v_min: r.v_min,
-            v_max: r.v_max,
-            radiance: rad.map(|c| c as f32),
-            edges: l.edges.clone(),
+    let lights = (0..st.rects.len())
+        .map(|k| {
+            let origin = &start[st.set_of[k]];
+            let (r, rad) = (st.rects[k], st.radiance[k]);
+            FittedLight {
+                streak_ids: origin.streak_ids.clone(),
+                plane: origin.plane.clone(),
+                u_min: r.u_min,
+                u_max: r.u_max,
+                v_min: r.v_min,
+                v_max: r.v_max,
+                radiance: rad.map(|c| c as f32),
+                edges: origin.edges.clone(),
+            }
         })
         .collect();
     (lights, uncertainty, sigma2)
@@ -1130,8 +1383,11 @@ fn uncertainty(
     sigma2: f64,
 ) -> Uncertainty {
     let mut edges = [None; 4];
-    if let Some(ext) = extents[k] {
+    if let Some(ext) = extents[st.set_of[k]] {
         for side in EdgeSide::ALL {
+            if st.pinned[k][side as usize] {
+                continue;
+            }
             let r = st.rects[k];
             let cur = r.edge(side);
             // A window of a few percent of the light: wide enough to average over the
