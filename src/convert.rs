@@ -29,12 +29,12 @@ pub const ASPECT_TOLERANCE: f32 = 0.005;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Method {
     /// The paper's per-streak estimate, then all lights refined together against every water
-    /// pixel near the streaks (render and compare), with per-parameter uncertainties. Opt-in
-    /// for now: it brings Table 1 within 0.5 % but moves a light whose streak runs out of the
-    /// photo (Table 3's light1) further off, and it costs ~6 s more (BENCHMARKS.md).
-    Joint,
-    /// The paper's per-streak estimate, with streaklight's corrections (METHOD §5).
+    /// pixel from which they can be seen (render and compare), a light split in two where
+    /// the residual shows overlapping streaks, with per-parameter uncertainties (the
+    /// default: BENCHMARKS.md has the accuracy of both methods).
     #[default]
+    Joint,
+    /// The paper's per-streak estimate alone, with streaklight's corrections (METHOD §5).
     Paper,
 }
 

@@ -55,10 +55,11 @@ pub struct Args {
     /// Use Smith shadowing in the reflection model (default: the paper's G = 1).
     #[arg(long)]
     pub smith: bool,
-    /// How to fit: "paper" (the paper's per-streak estimate, corrected) or "joint" (that
-    /// estimate refined by fitting all lights together to every water pixel near the streaks,
-    /// with per-parameter uncertainties in the report; slower, experimental).
-    #[arg(long, default_value = "paper", value_parser = ["joint", "paper"])]
+    /// How to fit: "joint" (the paper's per-streak estimate refined by fitting all lights
+    /// together to every water pixel that can see them, splitting a light whose streak holds
+    /// two, with per-parameter uncertainties in the report) or "paper" (the per-streak
+    /// estimate alone, corrected; faster, for comparison).
+    #[arg(long, default_value = "joint", value_parser = ["joint", "paper"])]
     pub method: String,
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]

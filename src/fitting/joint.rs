@@ -82,7 +82,7 @@ impl JointOptions {
 }
 
 /// Default lobe samples per pixel of the joint fit.
-pub const DEFAULT_JOINT_SAMPLES: u32 = 128;
+pub const DEFAULT_JOINT_SAMPLES: u32 = 72;
 
 /// One-sigma uncertainties of a light's parameters.
 #[derive(Clone, Debug, PartialEq)]
@@ -731,6 +731,7 @@ impl Problem {
         let mut half_difference = vec![0f32; grid];
         // Clipped pixels need the whole c(t) to apply their one-sided residual later.
         let mut clipped_rows: Vec<(usize, Vec<f32>)> = Vec::new();
+        let mut flat = FlatSums::default();
         for &i in chunk {
             let r = plane.range(i);
             if r.is_empty() {
@@ -749,12 +750,10 @@ impl Problem {
                 if c != 0.0 {
                     let d = st.dev[k][i] as f64;
                     let (rest, rest_dev) = self.others(st, k, i);
-                    for j in 0..grid {
-                        a_raw[j] += c * c;
-                        a[j] += c * c - d * d;
-                        for ch in 0..3 {
-                            b[j][ch] += c * (self.obs[i][ch] as f64 - rest[ch]) + d * rest_dev[ch];
-                        }
+                    flat.a_raw += c * c;
+                    flat.a += c * c - d * d;
+                    for ch in 0..3 {
+                        flat.b[ch] += c * (self.obs[i][ch] as f64 - rest[ch]) + d * rest_dev[ch];
                     }
                 }
                 continue;
@@ -845,6 +844,7 @@ impl Problem {
             a,
             a_raw,
             b,
+            flat,
             clipped_rows,
         }
     }
@@ -874,10 +874,10 @@ impl Problem {
         let mut clipped_rows: Vec<(usize, Vec<f32>)> = Vec::new();
         for part in parts {
             for j in 0..grid {
-                a[j] += part.a[j];
-                a_raw[j] += part.a_raw[j];
+                a[j] += part.a[j] + part.flat.a;
+                a_raw[j] += part.a_raw[j] + part.flat.a_raw;
                 for ch in 0..3 {
-                    b[j][ch] += part.b[j][ch];
+                    b[j][ch] += part.b[j][ch] + part.flat.b[ch];
                 }
             }
             clipped_rows.extend(part.clipped_rows);
@@ -984,7 +984,17 @@ struct ProfileSums {
     a: Vec<f64>,
     a_raw: Vec<f64>,
     b: Vec<[f64; 3]>,
+    /// The same at every grid point (pixels with no sample in the window), kept once.
+    flat: FlatSums,
     clipped_rows: Vec<(usize, Vec<f32>)>,
+}
+
+/// Normal-equation sums that do not depend on the edge's grid position.
+#[derive(Default)]
+struct FlatSums {
+    a: f64,
+    a_raw: f64,
+    b: [f64; 3],
 }
 
 /// How far the photo could possibly move an edge: the extent of light k's stored samples.
@@ -1019,7 +1029,7 @@ fn first_window(r: &Rect) -> f32 {
 /// Where on its plane a light's edges may go during the fit: the start rectangle grown by
 /// the first search window and a little more. Samples landing outside it are never traced.
 fn region_of_interest(start: &Rect) -> Rect {
-    let grow = 1.5 * first_window(start);
+    let grow = 1.25 * first_window(start);
     Rect {
         u_min: start.u_min - grow,
         u_max: start.u_max + grow,
@@ -1326,17 +1336,6 @@ fn optimise(
             problem.descend(&mut st, &extents, sweeps);
             cost = problem.cost(&st);
         }
-    }
-    if let Ok(path) = std::env::var("STREAKLIGHT_JOINT_DUMP") {
-        let mut out = String::new();
-        for i in 0..problem.n() {
-            let m = problem.model(&st, i);
-            out += &format!(
-                "{} {} {} {}\n",
-                problem.pixel_ids[i], problem.obs[i][0], m[0], problem.clipped[i] as u8
-            );
-        }
-        let _ = std::fs::write(path, out);
     }
     let sigma2 = (cost / dof(st.rects.len())).max(f64::MIN_POSITIVE);
     let uncertainty = (0..st.rects.len())
