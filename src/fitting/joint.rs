@@ -1,19 +1,25 @@
 //! Joint refinement of all lights by render and compare (METHOD §5, last paragraph; issue 5).
 //!
-//! The paper fits each streak alone from its edge pixels. Here every water pixel near any
-//! streak counts, and all lights are fitted together: minimise
+//! The paper fits each streak alone from its edge pixels. Here every water pixel from which
+//! a light can be seen counts, and all lights are fitted together: minimise
 //!
 //! ```text
 //! S = sum_p sum_c (I_c(p) - sum_k L_k,c c_k(p; rect_k))^2
 //! ```
 //!
 //! where a clipped pixel only counts when the model is below it (it is a lower bound,
-//! METHOD §2). Each pixel's coefficient is integrated over its footprint exactly as the
-//! renderer samples it (jittered camera ray, one lobe sample each). The samples of every pixel
-//! that land on each light's plane are traced ONCE; afterwards `c_k(p; rect)` for any rectangle
-//! is a sum over stored samples, so the optimisation traces no ray. The stored samples are
-//! common random numbers across all parameter values, so the cost is a deterministic function
-//! of the rectangles and the search is not confused by fresh noise at each evaluation.
+//! METHOD §2). The fitted region is the streaks, dilated, plus every pixel near them whose
+//! reflected rays can reach a light's region of interest: a streak's faint ends fall below
+//! any segmentation's threshold, and an edge seen only through them would otherwise drift.
+//!
+//! Each pixel's coefficient is integrated over its footprint as the renderer does it
+//! ([`crate::render::camera_hit`]): stratified jittered camera rays, each with a stratified
+//! set of lobe samples, in two independent halves whose difference measures the estimate's
+//! noise. The samples that land on each light's plane inside its region of interest are
+//! traced ONCE; afterwards `c_k(p; rect)` for any rectangle is a sum over stored samples, so
+//! the optimisation traces no ray. The stored samples are common random numbers across all
+//! parameter values, so the cost is a deterministic function of the rectangles, and the
+//! coefficients' own noise is removed from it (see the note on the coefficients' noise).
 //!
 //! The model is linear in the radiances: given the rectangles they are a nonnegative least
 //! squares solve per channel. The edges are found by coordinate descent where each 1D step
@@ -21,7 +27,13 @@
 //! (prefix sums over binned samples), with that light's radiance re-optimised in closed form at
 //! every grid point, so a far-off start (the paper's estimate can be metres off) is pulled in
 //! by a global 1D search rather than a local step. The grid then shrinks around the best
-//! position until it is finer than a millimetre.
+//! position until it is finer than a millimetre. An edge that no pixel of the streak's edge
+//! looks at (outside the photo) is held where the paper method put it.
+//!
+//! Overlapping streaks (two lights whose reflections merge into one region, the paper's
+//! §5.3): when the residual of a fit is structured along the image rows, each light is tried
+//! as two (one above the other, or side by side), and the split is kept when it removes most
+//! of that structure.
 
 use std::time::Instant;
 
