@@ -888,8 +888,8 @@ impl Problem {
             for j in 0..grid {
                 a[j] += part.a[j] + part.flat.a;
                 a_raw[j] += part.a_raw[j] + part.flat.a_raw;
-                for ch in 0..3 {
-                    b[j][ch] += part.b[j][ch] + part.flat.b[ch];
+                for ((total, here), flat) in b[j].iter_mut().zip(part.b[j]).zip(part.flat.b) {
+                    *total += here + flat;
                 }
             }
             clipped_rows.extend(part.clipped_rows);
