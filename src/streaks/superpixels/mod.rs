@@ -203,7 +203,7 @@ pub fn slic(
         );
         update(&lab, w, &labels, &mut centres);
     }
-    let (labels, count) = enforce_connectivity(&labels, w, h, n / centres.len().max(1));
+    let count = enforce_connectivity(&mut labels, w, h, n / centres.len().max(1));
     Ok(Superpixels {
         width,
         height,
