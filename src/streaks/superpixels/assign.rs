@@ -1,208 +1,456 @@
-//! The assignment and update steps of SLIC.
+//! The assignment and update steps of SLIC, fused: the image is cut into bands of rows, and a
+//! band is assigned and then summed for the update while it is still in cache. The distances
+//! live only in a band-sized scratch buffer.
+//!
+//! Every pixel compares the centres whose window holds it in index order, as in the sequential
+//! algorithm, so the labels do not depend on how the bands are spread over the threads; the
+//! sums are integers, so neither do the centres.
 
 use rayon::prelude::*;
 
-use super::lab::LabImage;
-use super::{Centre, BAND_ROWS, FIXED};
+use super::lab::{LabImage, LAB_LIMIT};
+use super::{Centre, FIXED};
 
-/// The assignment step: every pixel takes the nearest centre whose window holds it.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn assign(
-    lab: &LabImage,
+/// Rows per band: small enough to spread over the threads and for a band's pixels, labels and
+/// distances to stay in the core's cache, large enough that a band's list of centres is worth
+/// building.
+const BAND_ROWS: usize = 16;
+
+/// Sums of one centre's pixels: L, a and b (times [`FIXED`]), x, y and their number.
+type Sums = [i64; 6];
+
+/// What one band of rows keeps from one iteration to the next, so that iterations allocate
+/// nothing.
+#[derive(Default)]
+struct Band {
+    /// The centres whose window reaches the band, in index order.
+    centres: Vec<u32>,
+    /// The sums of each of `centres`.
+    sums: Vec<Sums>,
+    /// When some pixel of the band kept a label that is not one of `centres` (no window
+    /// reached it), all the band's sums are here instead, by label.
+    strays: Vec<(u32, Sums)>,
+}
+
+/// The assignment and update steps, with the state they keep between iterations.
+pub(super) struct Iterations {
+    window: Windows,
+    bands: Vec<Band>,
+    sums: Vec<Sums>,
+}
+
+/// The image size and the centres' search windows.
+#[derive(Clone, Copy)]
+struct Windows {
     w: usize,
     h: usize,
-    centres: &[Centre],
+    /// Half the side of a centre's search window.
     offset: i64,
-    inv_weight: f32,
-    labels: &mut [u32],
-    dist: &mut [f32],
-) {
-    let bands = h.div_ceil(BAND_ROWS);
-    let y_range = |c: &Centre| {
-        let y0 = ((c.y as i64) - offset).max(0) as usize;
-        let y1 = ((c.y as i64) + offset).min(h as i64).max(0) as usize;
-        (y0, y1)
-    };
-    let mut by_band: Vec<Vec<u32>> = vec![Vec::new(); bands];
-    for (k, c) in centres.iter().enumerate() {
-        let (y0, y1) = y_range(c);
-        if y0 >= y1 {
-            continue;
-        }
-        for list in &mut by_band[y0 / BAND_ROWS..=(y1 - 1) / BAND_ROWS] {
-            list.push(k as u32);
+    /// The weight of the squared distance in the image, (m / S)^2, times FIXED^2 as the colour
+    /// distance is taken between colours times FIXED. Scaling by a power of two changes no
+    /// rounding, so the distances are those in Lab units times FIXED^2, exactly (short of
+    /// overflow, i.e. for any compactness below about 1e15).
+    weight: f32,
+}
+
+impl Iterations {
+    /// `inv_weight` is (m / S)^2.
+    pub(super) fn new(w: usize, h: usize, offset: i64, inv_weight: f32) -> Self {
+        Iterations {
+            window: Windows {
+                w,
+                h,
+                offset,
+                weight: inv_weight * (FIXED * FIXED),
+            },
+            bands: (0..h.div_ceil(BAND_ROWS))
+                .map(|_| Band::default())
+                .collect(),
+            sums: Vec::new(),
         }
     }
-    labels
-        .par_chunks_mut(BAND_ROWS * w)
-        .zip(dist.par_chunks_mut(BAND_ROWS * w))
-        .zip(by_band.par_iter())
-        .enumerate()
-        .for_each(|(band, ((band_labels, band_dist), band_centres))| {
-            band_dist.fill(f32::INFINITY);
-            let band_y0 = band * BAND_ROWS;
-            let band_y1 = band_y0 + band_labels.len() / w;
-            for &k in band_centres {
-                let c = &centres[k as usize];
-                let (y0, y1) = y_range(c);
-                let x0 = ((c.x as i64) - offset).max(0) as usize;
-                let x1 = ((c.x as i64) + offset).min(w as i64).max(0) as usize;
-                if x0 >= x1 {
-                    continue;
-                }
-                for y in y0.max(band_y0)..y1.min(band_y1) {
-                    let dy = y as f32 - c.y;
-                    let dy_term = dy * dy * inv_weight;
-                    let row = y * w;
-                    let local = (y - band_y0) * w;
-                    let len = x1 - x0;
-                    let ls = &lab.l[row + x0..row + x1];
-                    let as_ = &lab.a[row + x0..row + x1];
-                    let bs = &lab.b[row + x0..row + x1];
-                    let ds = &mut band_dist[local + x0..local + x1];
-                    let lbs = &mut band_labels[local + x0..local + x1];
-                    let (ls, as_, bs) = (&ls[..len], &as_[..len], &bs[..len]);
-                    let (ds, lbs) = (&mut ds[..len], &mut lbs[..len]);
-                    let dx0 = x0 as f32 - c.x;
-                    let (cl, ca, cb) = (c.l, c.a, c.b);
-                    distance_row(
-                        ls,
-                        as_,
-                        bs,
-                        ds,
-                        lbs,
-                        [cl, ca, cb, dx0, inv_weight, dy_term],
-                        k,
-                    );
+
+    /// One assignment step: every pixel reached by a window takes the nearest such centre
+    /// (others keep their label). Then, if `update`, every centre moves to the mean colour and
+    /// position of its pixels; a centre without pixels stays where it is.
+    pub(super) fn step(
+        &mut self,
+        lab: &LabImage,
+        centres: &mut [Centre],
+        labels: &mut [u32],
+        update: bool,
+    ) {
+        let windows = self.window;
+        for band in &mut self.bands {
+            band.centres.clear();
+        }
+        for (k, c) in centres.iter().enumerate() {
+            let (x0, x1, y0, y1) = windows.window(c);
+            if x0 >= x1 || y0 >= y1 {
+                continue;
+            }
+            for band in &mut self.bands[y0 / BAND_ROWS..=(y1 - 1) / BAND_ROWS] {
+                band.centres.push(k as u32);
+            }
+        }
+        let shared: &[Centre] = centres;
+        labels
+            .par_chunks_mut(BAND_ROWS * windows.w)
+            .zip(self.bands.par_iter_mut())
+            .enumerate()
+            .for_each_init(Scratch::default, |scratch, (b, (band_labels, band))| {
+                windows.band_step(
+                    lab,
+                    shared,
+                    b * BAND_ROWS,
+                    band_labels,
+                    band,
+                    scratch,
+                    update,
+                );
+            });
+        if !update {
+            return;
+        }
+
+        self.sums.clear();
+        self.sums.resize(centres.len(), [0; 6]);
+        for band in &self.bands {
+            for (&k, s) in band.centres.iter().zip(&band.sums) {
+                add(&mut self.sums[k as usize], s);
+            }
+            for (k, s) in &band.strays {
+                add(&mut self.sums[*k as usize], s);
+            }
+        }
+        for (c, s) in centres.iter_mut().zip(&self.sums) {
+            if s[5] == 0 {
+                continue;
+            }
+            let count = s[5] as f64;
+            *c = Centre {
+                l: (s[0] as f64 / count / FIXED as f64) as f32,
+                a: (s[1] as f64 / count / FIXED as f64) as f32,
+                b: (s[2] as f64 / count / FIXED as f64) as f32,
+                x: (s[3] as f64 / count) as f32,
+                y: (s[4] as f64 / count) as f32,
+            };
+        }
+    }
+}
+
+impl Windows {
+    /// The columns `x0..x1` and rows `y0..y1` of a centre's search window.
+    fn window(&self, c: &Centre) -> (usize, usize, usize, usize) {
+        let span = |at: f32, len: usize| {
+            let lo = ((at as i64) - self.offset).max(0) as usize;
+            let hi = ((at as i64) + self.offset).min(len as i64).max(0) as usize;
+            (lo, hi)
+        };
+        let (x0, x1) = span(c.x, self.w);
+        let (y0, y1) = span(c.y, self.h);
+        (x0, x1, y0, y1)
+    }
+
+    /// The assignment, and if `update` the sums, of the band whose first row is `y_start`.
+    #[allow(clippy::too_many_arguments)]
+    fn band_step(
+        &self,
+        lab: &LabImage,
+        centres: &[Centre],
+        y_start: usize,
+        labels: &mut [u32],
+        band: &mut Band,
+        scratch: &mut Scratch,
+        update: bool,
+    ) {
+        let w = self.w;
+        let y_end = y_start + labels.len() / w;
+        let Scratch { dist, spatial } = scratch;
+        dist.clear();
+        dist.resize(labels.len(), f32::INFINITY);
+        for &k in &band.centres {
+            let c = &centres[k as usize];
+            let (x0, x1, y0, y1) = self.window(c);
+            // The column part of the spatial term is the same in every row of the window.
+            let dx0 = x0 as f32 - c.x;
+            spatial.clear();
+            spatial.extend((0..x1 - x0).map(|i| {
+                let dx = dx0 + (i as i32) as f32;
+                dx * dx * self.weight
+            }));
+            let colour = [c.l * FIXED, c.a * FIXED, c.b * FIXED];
+            for y in y0.max(y_start)..y1.min(y_end) {
+                let dy = y as f32 - c.y;
+                let image = y * w + x0..y * w + x1;
+                let local = (y - y_start) * w + x0..(y - y_start) * w + x1;
+                distance_row(
+                    [&lab.l[image.clone()], &lab.a[image.clone()], &lab.b[image]],
+                    spatial,
+                    &mut dist[local.clone()],
+                    &mut labels[local],
+                    (colour, dy * dy * self.weight),
+                    k,
+                );
+            }
+        }
+        if !update {
+            return;
+        }
+
+        band.sums.clear();
+        band.sums.resize(band.centres.len(), [0; 6]);
+        band.strays.clear();
+        let mut counted = 0;
+        for (&k, sums) in band.centres.iter().zip(&mut band.sums) {
+            let (x0, x1, y0, y1) = self.window(&centres[k as usize]);
+            for y in y0.max(y_start)..y1.min(y_end) {
+                let image = y * w + x0..y * w + x1;
+                let local = (y - y_start) * w + x0..(y - y_start) * w + x1;
+                let [l, a, b, count, x_offsets] = sum_row(
+                    [&lab.l[image.clone()], &lab.a[image.clone()], &lab.b[image]],
+                    &labels[local],
+                    k,
+                );
+                let row = [
+                    l,
+                    a,
+                    b,
+                    x_offsets + x0 as i64 * count,
+                    y as i64 * count,
+                    count,
+                ];
+                add(sums, &row);
+                counted += count as usize;
+            }
+        }
+        if counted < labels.len() {
+            // Some pixel kept a label whose centre's window does not reach it (rare: only
+            // where no window reached the pixel this time). Sum the band pixel by pixel.
+            band.sums.iter_mut().for_each(|s| *s = [0; 6]);
+            for (i, &k) in labels.iter().enumerate() {
+                let (x, y) = (i % w, y_start + i / w);
+                let j = y * w + x;
+                let pixel = [
+                    lab.l[j] as i64,
+                    lab.a[j] as i64,
+                    lab.b[j] as i64,
+                    x as i64,
+                    y as i64,
+                    1,
+                ];
+                match band.strays.last_mut() {
+                    Some((last, s)) if *last == k => add(s, &pixel),
+                    _ => band.strays.push((k, pixel)),
                 }
             }
-        });
+        }
+    }
+}
+
+/// Buffers of one worker, reused from band to band.
+#[derive(Default)]
+struct Scratch {
+    /// The distance of every pixel of the band to its centre so far.
+    dist: Vec<f32>,
+    /// The column part of the spatial term, along a window's row.
+    spatial: Vec<f32>,
+}
+
+fn add(to: &mut Sums, s: &Sums) {
+    for (t, v) in to.iter_mut().zip(s) {
+        *t += v;
+    }
 }
 
 /// One row of a centre's window: the distance of every pixel to the centre, kept with the
-/// label when it beats the pixel's best so far. `c` = (L, a, b, dx of the first pixel,
-/// spatial weight, dy term). Written over fixed blocks of 8 with branch-free selects, so that
-/// the compiler vectorises it.
+/// label `k` when it beats the pixel's best so far. `centre` is the colour times FIXED and the
+/// row part of the spatial term. A plain loop with branch-free selects on bit masks, which the
+/// compiler vectorises (with `if`, it makes branches and does not).
 #[inline(always)]
 fn distance_row(
-    ls: &[f32],
-    as_: &[f32],
-    bs: &[f32],
-    ds: &mut [f32],
-    lbs: &mut [u32],
-    c: [f32; 6],
+    lab: [&[f32]; 3],
+    spatial: &[f32],
+    dist: &mut [f32],
+    labels: &mut [u32],
+    centre: ([f32; 3], f32),
     k: u32,
 ) {
-    const B: usize = 8;
-    let [cl, ca, cb, dx0, inv_weight, dy_term] = c;
-    let len = ds.len();
-    let blocks = len / B;
-    let one = |j: usize, d: &mut f32, lb: &mut u32, l: f32, a: f32, b: f32| {
-        let dx = dx0 + (j as i32) as f32;
-        let (dl, da, db) = (l - cl, a - ca, b - cb);
-        let v = dl * dl + da * da + db * db + dx * dx * inv_weight + dy_term;
-        let better = v < *d;
-        *d = if better { v } else { *d };
-        *lb = if better { k } else { *lb };
-    };
-    for blk in 0..blocks {
-        let o = blk * B;
-        let l: &[f32; B] = ls[o..o + B].try_into().unwrap_or(&[0.0; B]);
-        let a: &[f32; B] = as_[o..o + B].try_into().unwrap_or(&[0.0; B]);
-        let b: &[f32; B] = bs[o..o + B].try_into().unwrap_or(&[0.0; B]);
-        let d: &mut [f32; B] = (&mut ds[o..o + B])
-            .try_into()
-            .unwrap_or_else(|_| unreachable!());
-        let lb: &mut [u32; B] = (&mut lbs[o..o + B])
-            .try_into()
-            .unwrap_or_else(|_| unreachable!());
-        let mut v = [0.0f32; B];
-        for j in 0..B {
-            let dx = dx0 + ((o + j) as i32) as f32;
-            let (dl, da, db) = (l[j] - cl, a[j] - ca, b[j] - cb);
-            v[j] = dl * dl + da * da + db * db + dx * dx * inv_weight + dy_term;
-        }
-        // Masks rather than `if`, which the compiler turns back into branches here.
-        let mut mask = [0u32; B];
-        for j in 0..B {
-            mask[j] = 0u32.wrapping_sub((v[j] < d[j]) as u32);
-        }
-        for j in 0..B {
-            d[j] = v[j].min(d[j]);
-            lb[j] = (k & mask[j]) | (lb[j] & !mask[j]);
-        }
-    }
-    for j in blocks * B..len {
-        one(j, &mut ds[j], &mut lbs[j], ls[j], as_[j], bs[j]);
+    let n = dist.len();
+    let (l, a, b) = (&lab[0][..n], &lab[1][..n], &lab[2][..n]);
+    let (spatial, labels) = (&spatial[..n], &mut labels[..n]);
+    let ([cl, ca, cb], dy_term) = centre;
+    for i in 0..n {
+        let (dl, da, db) = (l[i] - cl, a[i] - ca, b[i] - cb);
+        // EPFL's order of operations, so that the sums round as they always have.
+        let v = dl * dl + da * da + db * db + spatial[i] + dy_term;
+        let d = dist[i];
+        let mask = 0u32.wrapping_sub((v < d) as u32);
+        dist[i] = f32::from_bits((v.to_bits() & mask) | (d.to_bits() & !mask));
+        labels[i] = (k & mask) | (labels[i] & !mask);
     }
 }
 
-/// The update step: every centre moves to the mean colour and position of its pixels.
-pub(super) fn update(lab: &LabImage, w: usize, labels: &[u32], centres: &mut [Centre]) {
-    let k = centres.len();
-    let threads = rayon::current_num_threads().max(1);
-    let rows = labels.len() / w;
-    let chunk_rows = rows.div_ceil(threads).max(1);
-    // Integer sums are exact, so neither the chunking nor the order of the reduction changes
-    // the result.
-    let sums = labels
-        .par_chunks(chunk_rows * w)
-        .enumerate()
-        .map(|(chunk, chunk_labels)| {
-            let mut s = vec![[0i64; 6]; k];
-            let base = chunk * chunk_rows * w;
-            for (r, row_labels) in chunk_labels.chunks(w).enumerate() {
-                let row = base + r * w;
-                let y = (base / w + r) as i64;
-                let fixed = &lab.fixed[row..row + row_labels.len()];
-                // Labels come in runs along a row: sum a run locally, then add it once.
-                let mut x = 0;
-                while x < row_labels.len() {
-                    let lb = row_labels[x];
-                    let start = x;
-                    let mut acc = [0i64; 3];
-                    while x < row_labels.len() && row_labels[x] == lb {
-                        let f = fixed[x];
-                        acc[0] += f[0] as i64;
-                        acc[1] += f[1] as i64;
-                        acc[2] += f[2] as i64;
-                        x += 1;
+/// The pixels of one row of a centre's window that carry its label `k`: sums of L, a and b
+/// (times FIXED), their number, and the sum of their columns counted from the row's start.
+#[inline(always)]
+fn sum_row(lab: [&[f32]; 3], labels: &[u32], k: u32) -> [i64; 5] {
+    // The values are integers of at most 16 bits: adding 1.5 * 2^23 moves them, exactly, to
+    // the low bits of the f32's mantissa, so that the sums are taken on the bits as integers
+    // (a loop the compiler vectorises, unlike float sums or saturating casts), and the offset
+    // is taken off at the end. Pieces of 2^8 pixels keep the true sums within i32.
+    const MAGIC: f32 = 12_582_912.0;
+    const PIECE: usize = 1 << 8;
+    const _: () = assert!(PIECE as i64 * LAB_LIMIT as i64 <= i32::MAX as i64);
+    let offset = MAGIC.to_bits() as i32;
+    let mut total = [0i64; 5];
+    for (p, labels) in labels.chunks(PIECE).enumerate() {
+        let n = labels.len();
+        let start = p * PIECE;
+        let [l, a, b] = lab.map(|plane| &plane[start..start + n]);
+        let mut acc = [0i32; 5];
+        for i in 0..n {
+            let mask = 0i32.wrapping_sub((labels[i] == k) as i32);
+            let bits = |v: f32| (v + MAGIC).to_bits() as i32 & mask;
+            acc[0] = acc[0].wrapping_add(bits(l[i]));
+            acc[1] = acc[1].wrapping_add(bits(a[i]));
+            acc[2] = acc[2].wrapping_add(bits(b[i]));
+            acc[3] -= mask;
+            acc[4] += i as i32 & mask;
+        }
+        let count = acc[3];
+        let colour = |c: i32| c.wrapping_sub(offset.wrapping_mul(count)) as i64;
+        let piece = [
+            colour(acc[0]),
+            colour(acc[1]),
+            colour(acc[2]),
+            count as i64,
+            acc[4] as i64 + start as i64 * count as i64,
+        ];
+        for (t, v) in total.iter_mut().zip(piece) {
+            *t += v;
+        }
+    }
+    total
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The steps as EPFL writes them, one pixel at a time, in Lab units: the banded, scaled
+    /// and vectorised steps must give the same labels and centres, bit for bit.
+    fn reference_step(
+        lab: &LabImage,
+        (w, h): (usize, usize),
+        centres: &mut [Centre],
+        (offset, inv_weight): (i64, f32),
+        labels: &mut [u32],
+    ) {
+        let mut dist = vec![f32::INFINITY; w * h];
+        for (k, c) in centres.iter().enumerate() {
+            let x0 = ((c.x as i64) - offset).max(0) as usize;
+            let x1 = ((c.x as i64) + offset).min(w as i64).max(0) as usize;
+            let y0 = ((c.y as i64) - offset).max(0) as usize;
+            let y1 = ((c.y as i64) + offset).min(h as i64).max(0) as usize;
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let i = y * w + x;
+                    let [l, a, b] = lab.colour(i);
+                    let (dl, da, db) = (l - c.l, a - c.a, b - c.b);
+                    let dx = (x0 as f32 - c.x) + ((x - x0) as i32) as f32;
+                    let dy = y as f32 - c.y;
+                    let v =
+                        dl * dl + da * da + db * db + dx * dx * inv_weight + dy * dy * inv_weight;
+                    if v < dist[i] {
+                        dist[i] = v;
+                        labels[i] = k as u32;
                     }
-                    let run = (x - start) as i64;
-                    let e = &mut s[lb as usize];
-                    e[0] += acc[0];
-                    e[1] += acc[1];
-                    e[2] += acc[2];
-                    // Sum of the columns start..x.
-                    e[3] += (start as i64 + x as i64 - 1) * run / 2;
-                    e[4] += y * run;
-                    e[5] += run;
                 }
             }
-            s
-        })
-        .reduce(
-            || vec![[0i64; 6]; k],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(&b) {
-                    for c in 0..6 {
-                        x[c] += y[c];
-                    }
-                }
-                a
-            },
-        );
-    for (c, s) in centres.iter_mut().zip(&sums) {
-        if s[5] == 0 {
-            continue;
         }
-        let count = s[5] as f64;
-        *c = Centre {
-            l: (s[0] as f64 / count / FIXED as f64) as f32,
-            a: (s[1] as f64 / count / FIXED as f64) as f32,
-            b: (s[2] as f64 / count / FIXED as f64) as f32,
-            x: (s[3] as f64 / count) as f32,
-            y: (s[4] as f64 / count) as f32,
+        let mut sums = vec![[0i64; 6]; centres.len()];
+        for (i, &k) in labels.iter().enumerate() {
+            let s = &mut sums[k as usize];
+            s[0] += lab.l[i] as i64;
+            s[1] += lab.a[i] as i64;
+            s[2] += lab.b[i] as i64;
+            s[3] += (i % w) as i64;
+            s[4] += (i / w) as i64;
+            s[5] += 1;
+        }
+        for (c, s) in centres.iter_mut().zip(&sums) {
+            if s[5] > 0 {
+                let count = s[5] as f64;
+                *c = Centre {
+                    l: (s[0] as f64 / count / FIXED as f64) as f32,
+                    a: (s[1] as f64 / count / FIXED as f64) as f32,
+                    b: (s[2] as f64 / count / FIXED as f64) as f32,
+                    x: (s[3] as f64 / count) as f32,
+                    y: (s[4] as f64 / count) as f32,
+                };
+            }
+        }
+    }
+
+    #[test]
+    fn bands_give_the_reference_steps() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut random = move |range: f32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * range
         };
+        // Sizes around the band height and the vector width; windows that overlap, and narrow
+        // ones that leave pixels no window reaches (which keep their label).
+        for &(w, h, k, offset) in &[
+            (37, 41, 12, 10),
+            (64, 16, 8, 9),
+            (53, 70, 6, 4),
+            (5, 3, 2, 1),
+        ] {
+            let n = w * h;
+            let mut plane = |range: f32| -> Vec<f32> {
+                (0..n)
+                    .map(|i| ((i % w) as f32 * 3.0 + random(range) * FIXED).round())
+                    .collect()
+            };
+            let lab = LabImage {
+                l: plane(100.0),
+                a: plane(50.0),
+                b: plane(50.0),
+            };
+            let mut centres: Vec<Centre> = (0..k)
+                .map(|_| Centre {
+                    l: random(100.0),
+                    a: random(50.0),
+                    b: random(50.0),
+                    x: random(w as f32),
+                    y: random(h as f32),
+                })
+                .collect();
+            let inv_weight = 0.37;
+            let mut reference = centres.clone();
+            let (mut labels, mut reference_labels) = (vec![0u32; n], vec![0u32; n]);
+            let mut iterations = Iterations::new(w, h, offset, inv_weight);
+            for _ in 0..4 {
+                iterations.step(&lab, &mut centres, &mut labels, true);
+                reference_step(
+                    &lab,
+                    (w, h),
+                    &mut reference,
+                    (offset, inv_weight),
+                    &mut reference_labels,
+                );
+                assert_eq!(labels, reference_labels, "{w} x {h}");
+                let bits = |c: &[Centre]| -> Vec<[u32; 5]> {
+                    c.iter()
+                        .map(|c| [c.l, c.a, c.b, c.x, c.y].map(f32::to_bits))
+                        .collect()
+                };
+                assert_eq!(bits(&centres), bits(&reference), "{w} x {h}");
+            }
+        }
     }
 }

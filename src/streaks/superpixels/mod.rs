@@ -19,16 +19,18 @@
 //! fixed point (Lab x 256, integers) so that the result is the same bytes whatever the thread
 //! count (METHOD §2, determinism).
 //!
-//! Parallelism: the assignment step splits the image into bands of rows, and each band visits
-//! the centres whose window touches it in index order, so every pixel sees the same sequence of
-//! comparisons as in the sequential algorithm; the update step sums integers per thread.
+//! Parallelism: the image is split into bands of rows (assign.rs); each band visits the centres
+//! whose window touches it in index order, so every pixel sees the same sequence of comparisons
+//! as in the sequential algorithm, and then sums its pixels for the update, as integers, while
+//! they are still in cache. Lab conversion and connectivity (on runs of labels) are parallel
+//! too.
 
 mod assign;
 mod connectivity;
 mod lab;
 
 use crate::{Error, Result};
-use assign::{assign, update};
+use assign::Iterations;
 use connectivity::enforce_connectivity;
 use lab::{to_lab, LabImage};
 
@@ -140,10 +142,6 @@ struct Centre {
     y: f32,
 }
 
-/// Rows per band of the parallel assignment step: small enough to spread over the threads,
-/// large enough that a band's list of centres is worth building.
-const BAND_ROWS: usize = 16;
-
 /// Segments an image given as sRGB-encoded colours in [0, 1] (row by row) into superpixels.
 pub fn slic(
     width: u32,
@@ -189,19 +187,11 @@ pub fn slic(
         1.0 / (s_over_m * s_over_m)
     };
     let mut labels = vec![0u32; n];
-    let mut dist = vec![f32::INFINITY; n];
-    for _ in 0..params.iterations {
-        assign(
-            &lab,
-            w,
-            h,
-            &centres,
-            offset,
-            inv_weight,
-            &mut labels,
-            &mut dist,
-        );
-        update(&lab, w, &labels, &mut centres);
+    let mut iterations = Iterations::new(w, h, offset, inv_weight);
+    for i in 0..params.iterations {
+        // The centres after the last assignment are not needed.
+        let update = i + 1 < params.iterations;
+        iterations.step(&lab, &mut centres, &mut labels, update);
     }
     let count = enforce_connectivity(&mut labels, w, h, n / centres.len().max(1));
     Ok(Superpixels {
@@ -229,11 +219,11 @@ fn grid_seeds(lab: &LabImage, w: usize, h: usize, step: usize) -> Vec<Centre> {
         for sx in 0..xstrips {
             let x = ((sx * step) as f64 + off + sx as f64 * xerr_per) as usize;
             let x = x.min(w - 1);
-            let i = y * w + x;
+            let [l, a, b] = lab.colour(y * w + x);
             centres.push(Centre {
-                l: lab.l[i],
-                a: lab.a[i],
-                b: lab.b[i],
+                l,
+                a,
+                b,
                 x: x as f32,
                 y: y as f32,
             });
@@ -246,11 +236,8 @@ fn grid_seeds(lab: &LabImage, w: usize, h: usize, step: usize) -> Vec<Centre> {
 /// so that no seed starts on an edge or a noisy pixel.
 fn perturb_seeds(lab: &LabImage, w: usize, h: usize, centres: &mut [Centre]) {
     let colour_sq = |i: usize, j: usize| {
-        let (dl, da, db) = (
-            lab.l[i] - lab.l[j],
-            lab.a[i] - lab.a[j],
-            lab.b[i] - lab.b[j],
-        );
+        let (ci, cj) = (lab.colour(i), lab.colour(j));
+        let (dl, da, db) = (ci[0] - cj[0], ci[1] - cj[1], ci[2] - cj[2]);
         dl * dl + da * da + db * db
     };
     let gradient = |x: usize, y: usize| -> f32 {
@@ -276,11 +263,11 @@ fn perturb_seeds(lab: &LabImage, w: usize, h: usize, centres: &mut [Centre]) {
                 }
             }
         }
-        let i = best.2 * w + best.1;
+        let [l, a, b] = lab.colour(best.2 * w + best.1);
         *c = Centre {
-            l: lab.l[i],
-            a: lab.a[i],
-            b: lab.b[i],
+            l,
+            a,
+            b,
             x: best.1 as f32,
             y: best.2 as f32,
         };
