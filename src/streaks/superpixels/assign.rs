@@ -12,9 +12,10 @@ use super::lab::{LabImage, LAB_LIMIT};
 use super::{Centre, FIXED};
 
 /// Rows per band: small enough to spread over the threads and for a band's pixels, labels and
-/// distances to stay in the core's cache, large enough that a band's list of centres is worth
-/// building.
-const BAND_ROWS: usize = 16;
+/// distances to stay in the core's cache (300 kB at 1920 pixels a row), large enough that a
+/// band's list of centres is worth building. 8 measured 5 % faster than 4, 12 or 16 at
+/// 1920 x 1080, S = 20.
+const BAND_ROWS: usize = 8;
 
 /// Sums of one centre's pixels: L, a and b (times [`FIXED`]), x, y and their number.
 type Sums = [i64; 6];
