@@ -21,49 +21,43 @@ pub(super) fn enforce_connectivity(
     const NONE: u32 = u32::MAX;
     let small = (mean_size / 4).max(1);
 
-    // The first column of every run, row by row; `first[y]..first[y + 1]` are the runs of row
-    // y. A run ends where the next one starts (or at the row's end), and its label is that of
-    // its first pixel. Counted first, so that the runs are written in place in parallel.
-    let starts_in = |row: &[u32]| 1 + row.windows(2).filter(|p| p[0] != p[1]).count();
-    let counts: Vec<usize> = labels.par_chunks(w).map(starts_in).collect();
+    // The first column of every run, row by row, each row closed by an entry `w`: the runs of
+    // row y are `first[y]..first[y + 1] - 1`, run r covers `start[r]..start[r + 1]`, and its
+    // label is that of its first pixel. Counted first, so that the rows are written in
+    // place, in parallel.
+    let slots_in = |row: &[u32]| 2 + row.windows(2).filter(|p| p[0] != p[1]).count();
+    let slots: Vec<usize> = labels.par_chunks(w).map(slots_in).collect();
     let mut first = Vec::with_capacity(h + 1);
     first.push(0usize);
-    for c in &counts {
+    for c in &slots {
         first.push(first[first.len() - 1] + c);
     }
-    let runs = first[h];
-    let mut start = vec![0u32; runs];
-    let mut out: &mut [u32] = &mut start;
-    let mut row_starts = Vec::with_capacity(h);
-    for &c in &counts {
-        let (row, rest) = out.split_at_mut(c);
-        row_starts.push(row);
-        out = rest;
+    let mut start = vec![0u32; first[h]];
+    let mut rest: &mut [u32] = &mut start;
+    let mut rows = Vec::with_capacity(h);
+    for &c in &slots {
+        let (row, others) = rest.split_at_mut(c);
+        rows.push(row);
+        rest = others;
     }
-    row_starts
-        .into_par_iter()
+    rows.into_par_iter()
         .zip(labels.par_chunks(w))
         .for_each(|(starts, row)| {
-            starts[0] = 0;
+            // Without a branch: every column is written as the start of the next run, and
+            // kept only where the label changes (the last write lands on the closing entry).
             let mut r = 1;
             for x in 1..row.len() {
-                if row[x] != row[x - 1] {
-                    starts[r] = x as u32;
-                    r += 1;
-                }
+                starts[r] = x as u32;
+                r += (row[x] != row[x - 1]) as usize;
             }
+            starts[0] = 0;
+            starts[r] = w as u32;
         });
-    let end = |y: usize, r: usize| -> u32 {
-        if r + 1 < first[y + 1] {
-            start[r + 1]
-        } else {
-            w as u32
-        }
-    };
+    let runs_of = |y: usize| first[y]..first[y + 1] - 1;
     let label = |y: usize, r: usize| labels[y * w + start[r] as usize];
 
     // Union-find whose root is always the smallest index of the set, so `parent[i] <= i`.
-    let mut parent: Vec<u32> = (0..runs as u32).collect();
+    let mut parent: Vec<u32> = (0..first[h] as u32).collect();
     fn find(parent: &mut [u32], mut i: u32) -> u32 {
         while parent[i as usize] != i {
             let p = parent[i as usize];
@@ -73,9 +67,10 @@ pub(super) fn enforce_connectivity(
         i
     }
     for y in 1..h {
-        let (mut i, mut j) = (first[y - 1], first[y]);
-        while i < first[y] && j < first[y + 1] {
-            let (up_end, here_end) = (end(y - 1, i), end(y, j));
+        let (above, here) = (runs_of(y - 1), runs_of(y));
+        let (mut i, mut j) = (above.start, here.start);
+        while i < above.end && j < here.end {
+            let (up_end, here_end) = (start[i + 1], start[j + 1]);
             // 4-connected: the column ranges share a column.
             if start[i] < here_end && start[j] < up_end && label(y - 1, i) == label(y, j) {
                 let (a, b) = (find(&mut parent, i as u32), find(&mut parent, j as u32));
@@ -95,23 +90,22 @@ pub(super) fn enforce_connectivity(
     // Every run's piece, named by its first run: parents come first, so one pass resolves
     // them in place. Then the size of every piece, at its first run.
     let mut piece = parent;
-    for r in 0..runs {
+    for r in 0..piece.len() {
         piece[r] = piece[piece[r] as usize];
     }
-    let mut size_then_label = vec![0u32; runs];
+    let mut size_then_label = vec![0u32; first[h]];
     for y in 0..h {
-        for r in first[y]..first[y + 1] {
-            size_then_label[piece[r] as usize] += end(y, r) - start[r];
+        for r in runs_of(y) {
+            size_then_label[piece[r] as usize] += start[r + 1] - start[r];
         }
     }
 
-    // The run of row `y` that holds column `x`.
-    let run_at = |y: usize, x: u32| -> usize {
-        first[y] + start[first[y]..first[y + 1]].partition_point(|&s| s <= x) - 1
-    };
     let mut next: u32 = 0;
     for y in 0..h {
-        for r in first[y]..first[y + 1] {
+        // The runs above and below that hold the column of the current run's first pixel;
+        // they only move right along the row.
+        let (mut up, mut down) = (first[y.saturating_sub(1)], first[(y + 1).min(h - 1)]);
+        for r in runs_of(y) {
             if piece[r] as usize != r {
                 continue;
             }
@@ -130,13 +124,19 @@ pub(super) fn enforce_connectivity(
                 look(r - 1);
             }
             if y > 0 {
-                look(run_at(y - 1, x));
+                while start[up + 1] <= x {
+                    up += 1;
+                }
+                look(up);
             }
-            if (x as usize) + 1 < w && end(y, r) == x + 1 {
+            if (x as usize) + 1 < w && start[r + 1] == x + 1 {
                 look(r + 1);
             }
             if y + 1 < h {
-                look(run_at(y + 1, x));
+                while start[down + 1] <= x {
+                    down += 1;
+                }
+                look(down);
             }
             size_then_label[r] = if size_then_label[r] as usize <= small && adjacent != NONE {
                 adjacent
@@ -147,14 +147,16 @@ pub(super) fn enforce_connectivity(
         }
     }
 
-    let new_label = |r: usize| size_then_label[piece[r] as usize];
     labels
         .par_chunks_mut(w)
         .with_min_len(16)
         .enumerate()
         .for_each(|(y, row)| {
-            for r in first[y]..first[y + 1] {
-                row[start[r] as usize..end(y, r) as usize].fill(new_label(r));
+            for r in runs_of(y) {
+                let new = size_then_label[piece[r] as usize];
+                for v in &mut row[start[r] as usize..start[r + 1] as usize] {
+                    *v = new;
+                }
             }
         });
     next as usize
