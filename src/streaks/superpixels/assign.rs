@@ -28,8 +28,9 @@ struct Band {
     centres: Vec<u32>,
     /// The sums of each of `centres`.
     sums: Vec<Sums>,
-    /// When some pixel of the band kept a label that is not one of `centres` (no window
-    /// reached it), all the band's sums are here instead, by label.
+    /// When some pixel of the band kept a label whose window does not reach it (no window
+    /// reached the pixel this time), all the band's sums are here instead, by label, and
+    /// `sums` are zero.
     strays: Vec<(u32, Sums)>,
 }
 
@@ -283,7 +284,7 @@ fn distance_row(
     let ([cl, ca, cb], dy_term) = centre;
     for i in 0..n {
         let (dl, da, db) = (l[i] - cl, a[i] - ca, b[i] - cb);
-        // EPFL's order of operations, so that the sums round as they always have.
+        // The terms in EPFL's order, as before, so that every distance rounds the same.
         let v = dl * dl + da * da + db * db + spatial[i] + dy_term;
         let d = dist[i];
         let mask = 0u32.wrapping_sub((v < d) as u32);
@@ -293,7 +294,8 @@ fn distance_row(
 }
 
 /// The pixels of one row of a centre's window that carry its label `k`: sums of L, a and b
-/// (times FIXED), their number, and the sum of their columns counted from the row's start.
+/// (times FIXED), their number, and the sum of their columns counted from the window's first
+/// column.
 #[inline(always)]
 fn sum_row(lab: [&[f32]; 3], labels: &[u32], k: u32) -> [i64; 5] {
     // The values are integers of at most 16 bits: adding 1.5 * 2^23 moves them, exactly, to

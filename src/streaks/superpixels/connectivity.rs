@@ -43,8 +43,10 @@ pub(super) fn enforce_connectivity(
     rows.into_par_iter()
         .zip(labels.par_chunks(w))
         .for_each(|(starts, row)| {
-            // Without a branch: every column is written as the start of the next run, and
-            // kept only where the label changes (the last write lands on the closing entry).
+            // Labels change every few pixels, at random, along ragged boundaries: rather than
+            // a branch mispredicted that often, every column is written as the start of the
+            // next run and kept only where the label changes (the last write lands on the
+            // closing entry).
             let mut r = 1;
             for x in 1..row.len() {
                 starts[r] = x as u32;
