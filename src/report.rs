@@ -97,9 +97,8 @@ pub struct LightReport {
     pub node_index: Option<usize>,
 }
 
-/// One-sigma uncertainties of a light's parameters, from the curvature of the joint fit's
-/// cost along each parameter with the others held (a lower bound where parameters trade
-/// against each other).
+/// One-sigma uncertainties of a light's parameters, from the joint fit's full covariance of
+/// all lights' free edges and radiances (correlated errors included).
 #[derive(Clone, Debug, Serialize)]
 pub struct UncertaintyReport {
     /// Left edge, metres (`None`: the photo does not constrain it).
