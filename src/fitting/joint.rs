@@ -588,8 +588,18 @@ impl Problem {
         m
     }
 
-    /// Residual sum of squares (clipped pixels only where the model is below them).
+    /// Residual sum of squares (clipped pixels only where the model is below them), less the
+    /// coefficients' own noise (see the note on it).
     fn cost(&self, st: &State) -> f64 {
+        self.residual_squares(st, true)
+    }
+
+    /// The plain residual sum of squares, the coefficients' noise left in.
+    fn raw_cost(&self, st: &State) -> f64 {
+        self.residual_squares(st, false)
+    }
+
+    fn residual_squares(&self, st: &State, remove_noise: bool) -> f64 {
         (0..self.n())
             .map(|i| {
                 let m = self.model(st, i);
@@ -598,8 +608,7 @@ impl Problem {
                         let r = self.obs[i][c] as f64 - m[c];
                         if self.clipped[i] && r < 0.0 {
                             0.0
-                        } else {
-                            // Less the part of r^2 that is the coefficients' own noise.
+                        } else if remove_noise {
                             let d: f64 = st
                                 .radiance
                                 .iter()
@@ -607,23 +616,6 @@ impl Problem {
                                 .map(|(k, l)| l[c] * st.dev[k][i] as f64)
                                 .sum();
                             r * r - d * d
-                        }
-                    })
-                    .sum::<f64>()
-            })
-            .sum()
-    }
-
-    /// The plain residual sum of squares (no noise removed; clipped pixels one-sided).
-    fn raw_cost(&self, st: &State) -> f64 {
-        (0..self.n())
-            .map(|i| {
-                let m = self.model(st, i);
-                (0..3)
-                    .map(|c| {
-                        let r = self.obs[i][c] as f64 - m[c];
-                        if self.clipped[i] && r < 0.0 {
-                            0.0
                         } else {
                             r * r
                         }
