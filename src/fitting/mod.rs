@@ -19,6 +19,7 @@
 pub mod edges;
 pub mod footprint;
 pub mod fragments;
+pub mod gloss;
 pub mod joint;
 pub mod light_plane;
 pub mod observation;
