@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use crate::fitting::gloss::GlossSearch;
 use crate::fitting::joint::{self, JointOptions, Uncertainty};
 use crate::fitting::{self, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::{ReflectionModel, Shadowing};
@@ -79,6 +80,9 @@ pub struct ConvertOptions {
     pub streak_params: StreakParams,
     /// Paper estimate alone, or refined jointly.
     pub method: Method,
+    /// Estimate the water's gloss from the photo together with the lights (`--gloss auto`;
+    /// the scene's or `load.gloss` is the search's start). Implies the joint fit.
+    pub estimate_gloss: bool,
 }
 
 impl ConvertOptions {
@@ -105,6 +109,7 @@ impl ConvertOptions {
             allow_empty: false,
             streak_params: StreakParams::default(),
             method: Method::default(),
+            estimate_gloss: false,
         }
     }
 }
@@ -210,8 +215,8 @@ fn uniform_water(photo: &Photo, water: &[bool]) -> Option<String> {
     })
 }
 
-/// The fitter's view of a streak.
-fn observation(streak: &streaks::Streak, width: u32) -> StreakObservation {
+/// A streak as the fitters take it: its id and pixels, and the photo width they index.
+pub fn observation(streak: &streaks::Streak, width: u32) -> StreakObservation {
     StreakObservation {
         id: streak.id,
         pixels: streak.pixels.clone(),
@@ -344,6 +349,12 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     if options.samples == 0 {
         return Err(Error::Usage("--samples must be at least 1".into()));
     }
+    if options.estimate_gloss && options.method == Method::Paper {
+        return Err(Error::Usage(
+            "--gloss auto fits the gloss with the joint fit: it cannot be combined with --method paper"
+                .into(),
+        ));
+    }
     let mut clock = Stopwatch(Vec::new());
     let scene = clock.time("load scene", || {
         scene_in::load(&options.scene, &options.load)
@@ -386,8 +397,36 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         },
     };
     let mut warnings: Vec<String> = scene.warnings.clone();
+    let mut uncertainties: Vec<Uncertainty> = Vec::new();
+    let mut gloss = (scene.water.gloss, scene.water.gloss_source.clone());
     let mut fit = if observations.is_empty() {
         None
+    } else if options.estimate_gloss {
+        let estimate = fitting::gloss::estimate_gloss(
+            &scene,
+            &photo,
+            &water,
+            &observations,
+            &GlossSearch {
+                fit: fit_options,
+                ..GlossSearch::for_scene(&scene)
+            },
+        )?;
+        gloss = (
+            estimate.gloss,
+            format!(
+                "estimated from the photo (--gloss auto, {} fits from e = {})",
+                estimate.evaluations.len(),
+                scene.water.gloss
+            ),
+        );
+        uncertainties = estimate.uncertainty;
+        Some(fitting::FitOutcome {
+            lights: estimate.lights,
+            skipped: estimate.skipped,
+            warnings: estimate.warnings,
+            timings: estimate.timings,
+        })
     } else {
         Some(fitting::fit_paper(
             &scene,
@@ -397,8 +436,8 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             &fit_options,
         )?)
     };
-    let mut uncertainties: Vec<Uncertainty> = Vec::new();
-    if let (Some(f), Method::Joint) = (fit.as_mut(), options.method) {
+    if let (Some(f), Method::Joint, false) = (fit.as_mut(), options.method, options.estimate_gloss)
+    {
         if !f.lights.is_empty() {
             let refined = joint::fit_joint(
                 &scene,
@@ -525,8 +564,8 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             output: Some(options.output.display().to_string()),
         },
         settings: Settings {
-            gloss: scene.water.gloss,
-            gloss_source: scene.water.gloss_source.clone(),
+            gloss: gloss.0,
+            gloss_source: gloss.1,
             ior: scene.water.ior,
             shadowing: match options.shadowing {
                 Shadowing::None => "none".into(),

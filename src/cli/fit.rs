@@ -25,9 +25,11 @@ pub struct Args {
     /// the photo beside the water re-rendered with the fitted lights).
     #[arg(long)]
     pub debug_dir: Option<PathBuf>,
-    /// Blinn-Phong gloss e of the water, overriding its material's roughness.
-    #[arg(long)]
-    pub gloss: Option<f32>,
+    /// Blinn-Phong gloss e of the water, overriding its material's roughness; or "auto" to
+    /// estimate it from the photo together with the lights (starting from the material's,
+    /// about 2-3 times slower).
+    #[arg(long, value_name = "E|auto")]
+    pub gloss: Option<GlossArg>,
     /// Index of refraction of the water (default: its material's KHR_materials_ior, else 1.33).
     #[arg(long)]
     pub ior: Option<f32>,
@@ -80,7 +82,10 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         load: LoadOptions {
             camera: args.camera,
             water: args.water,
-            gloss: args.gloss,
+            gloss: match args.gloss {
+                Some(GlossArg::Value(e)) => Some(e),
+                _ => None,
+            },
             ior: args.ior,
             nits_scale: args.nits_scale,
         },
@@ -100,6 +105,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         } else {
             Method::Joint
         },
+        estimate_gloss: matches!(args.gloss, Some(GlossArg::Auto)),
     };
     let outcome = convert(&options)?;
     for w in &outcome.report.warnings {
@@ -129,4 +135,26 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         total
     );
     Ok(())
+}
+
+/// `--gloss`: a value, or "auto".
+#[derive(Clone, Copy, Debug)]
+pub enum GlossArg {
+    /// Blinn-Phong exponent e.
+    Value(f32),
+    /// Estimate it from the photo.
+    Auto,
+}
+
+impl std::str::FromStr for GlossArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        if s.eq_ignore_ascii_case("auto") {
+            return Ok(GlossArg::Auto);
+        }
+        s.parse::<f32>().map(GlossArg::Value).map_err(|_| {
+            format!("expected a number (the Blinn-Phong exponent e) or \"auto\", got \"{s}\"")
+        })
+    }
 }

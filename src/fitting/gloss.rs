@@ -82,8 +82,8 @@
 
 use std::time::Instant;
 
-use super::joint::{self, fit_joint, JointOptions, JointOutcome, Uncertainty};
-use super::{fit_paper, FitOptions, FittedLight, Skipped, StreakObservation};
+use super::joint::{self, fit_joint, JointOptions, Uncertainty};
+use super::{fit_paper, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
@@ -263,6 +263,23 @@ pub fn estimate_gloss(
         )));
     }
     let mut warnings = paper.warnings.clone();
+    // The paper fit under the start gloss places an edge it found no pixel for at the lobes'
+    // farthest reach, and the joint fit would hold it there; under another gloss that reach
+    // is another, so the search lets every edge move.
+    let start: Vec<FittedLight> = paper
+        .lights
+        .iter()
+        .map(|l| FittedLight {
+            edges: l.edges.clone().map(|e| match e {
+                EdgeStatus::Unconstrained { reason, .. } => EdgeStatus::Unconstrained {
+                    reason,
+                    unseen: false,
+                },
+                constrained => constrained,
+            }),
+            ..l.clone()
+        })
+        .collect();
 
     let t = Instant::now();
     let mut cost = Cost {
@@ -270,7 +287,7 @@ pub fn estimate_gloss(
         photo,
         water,
         streaks,
-        start: &paper.lights,
+        start: &start,
         options,
         evaluations: Vec::new(),
         failed: Vec::new(),
@@ -357,6 +374,15 @@ fn model_at(options: &GlossSearch, gloss: f32) -> ReflectionModel {
     }
 }
 
+/// The gloss whose lobe picks the fitted pixels for every candidate: a quarter of the start
+/// (no lower than the search's floor), broad enough to hold the streaks of the candidates the
+/// search visits from there. With the region following each candidate's own lobe, a broader
+/// lobe added faint pixels, and with them cost, which pushed the estimate up (e = 200 came
+/// out 223).
+fn region_gloss(options: &GlossSearch) -> f32 {
+    (options.fit.model.gloss / 4.0).max(options.min_gloss)
+}
+
 /// The cost of a candidate gloss, with a record of every evaluation.
 struct Cost<'a> {
     scene: &'a Scene,
@@ -369,16 +395,6 @@ struct Cost<'a> {
     evaluations: Vec<(f64, f64)>,
     /// Evaluations whose fit broke down (module doc), for a warning.
     failed: Vec<f32>,
-}
-
-/// The residual sum of squares behind a joint outcome: its variance per degree of freedom
-/// times the degrees of freedom, counted as [`fit_joint`] counts them (three channels per
-/// pixel, less seven parameters per light).
-fn residual_sum(outcome: &JointOutcome) -> f64 {
-    let dof = (3 * outcome.pixels)
-        .saturating_sub(7 * outcome.lights.len())
-        .max(1);
-    outcome.residual_variance * dof as f64
 }
 
 impl Cost<'_> {
@@ -394,13 +410,17 @@ impl Cost<'_> {
             &JointOptions {
                 samples: self.options.search_samples,
                 sweeps: self.options.search_sweeps,
+                // A wrong gloss leaves a structured residual too: splitting lights there
+                // would fit the lobe's error, not a second light.
+                split: false,
+                region_gloss: Some(region_gloss(self.options)),
                 ..JointOptions::new(model_at(self.options, gloss), self.options.fit.seed)
             },
         )?;
-        let mut s = residual_sum(&fit);
+        let mut s = fit.cost;
         // The residuals hold the photo's own noise, so a cost that is not positive is the fit
         // exploiting its coefficients' noise (module doc): no evidence for this gloss.
-        if !(s.is_finite() && fit.residual_variance > MIN_VARIANCE) {
+        if !(s.is_finite() && s > 0.0) {
             self.failed.push(gloss);
             s = f64::INFINITY;
         }
@@ -412,11 +432,6 @@ impl Cost<'_> {
         })
     }
 }
-
-/// Below this residual variance per degree of freedom a fit has broken down: [`fit_joint`]
-/// floors the variance at the smallest positive double when its noise-debiased cost is not
-/// positive, and no real photo is that clean.
-const MIN_VARIANCE: f64 = 1e-300;
 
 /// A point of the cost curve: `x = ln e`, its cost and residual variance.
 #[derive(Clone, Copy, Debug)]

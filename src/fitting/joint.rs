@@ -76,6 +76,10 @@ pub struct JointOptions {
     /// Try explaining each light as two (overlapping streaks), keeping the split when it
     /// fits the photo far better.
     pub split: bool,
+    /// The gloss whose lobe decides which pixels around the streaks are fitted (`None`: the
+    /// model's). Fits under different glosses are comparable only over the same pixels, so a
+    /// gloss search fixes it to the broadest lobe it will try.
+    pub region_gloss: Option<f32>,
 }
 
 impl JointOptions {
@@ -89,6 +93,7 @@ impl JointOptions {
             sweeps: 14,
             checkerboard: true,
             split: true,
+            region_gloss: None,
         }
     }
 }
@@ -117,6 +122,10 @@ pub struct JointOutcome {
     pub pixels: usize,
     /// Residual sum of squares per pixel and channel at the optimum (radiance units squared).
     pub residual_variance: f64,
+    /// The fit's cost at the optimum: the residual sum of squares less the samples' own noise
+    /// (module doc); comparable between fits of the same pixels. Not positive when the fit
+    /// has broken down (the photo's own noise keeps a sound fit's cost positive).
+    pub cost: f64,
     /// Wall-clock seconds: "footprints" and "optimise".
     pub timings: Vec<(String, f64)>,
 }
@@ -1068,6 +1077,7 @@ pub fn fit_joint(
             uncertainty: Vec::new(),
             pixels: 0,
             residual_variance: 0.0,
+            cost: 0.0,
             timings: Vec::new(),
         });
     }
@@ -1090,9 +1100,13 @@ pub fn fit_joint(
         .iter()
         .map(|l| region_of_interest(&l.rect()))
         .collect();
+    let probe_model = ReflectionModel {
+        gloss: options.region_gloss.unwrap_or(options.model.gloss),
+        ..options.model
+    };
     let pixels = region(
         scene,
-        &options.model,
+        &probe_model,
         &planes,
         &roi,
         photo,
@@ -1122,12 +1136,14 @@ pub fn fit_joint(
         planes: stored,
         inv_samples: 1.0 / per_pixel_samples as f32,
     };
-    let (lights, uncertainty, variance) = optimise(&problem, start, options.sweeps, options.split);
+    let (lights, uncertainty, variance, cost) =
+        optimise(&problem, start, options.sweeps, options.split);
     Ok(JointOutcome {
         lights,
         uncertainty,
         pixels: pixels.len(),
         residual_variance: variance,
+        cost,
         timings: vec![
             ("footprints".into(), footprint_seconds),
             ("optimise".into(), t1.elapsed().as_secs_f64()),
@@ -1307,7 +1323,7 @@ fn optimise(
     start: &[FittedLight],
     sweeps: u32,
     split: bool,
-) -> (Vec<FittedLight>, Vec<Uncertainty>, f64) {
+) -> (Vec<FittedLight>, Vec<Uncertainty>, f64, f64) {
     let extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
     let mut st = problem.state(
         (0..start.len()).collect(),
@@ -1359,7 +1375,7 @@ fn optimise(
             }
         })
         .collect();
-    (lights, uncertainty, sigma2)
+    (lights, uncertainty, sigma2, cost)
 }
 
 /// Where an edge may go: inside the samples' extent and not past the opposite edge.
