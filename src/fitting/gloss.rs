@@ -66,10 +66,11 @@
 //! the cost by the residual variance per degree of freedom `s2`, so `sigma(ln e) = sqrt(s2 / k)`.
 //! That is the photo's statistical limit (pixel noise independent): it leaves out the model's
 //! own errors and the Monte Carlo noise of the fits, and is a lower bound. On the samples it
-//! is 0.1-0.2 %, while the seed of the fits moves the estimate by about 1 % (seeds 1-3:
-//! 201-206 for e = 200, 494-503 for 500, 999.6-1000.9 for 1000), and the parabola's shape
-//! assumption by about as much (the vertex through the same three points taken in `1/e`
-//! instead of `ln e` differs by 0.4-1.1 %). Read the estimate as good to a few percent.
+//! is 0.1-0.2 %, while the estimates (`tests/gloss.rs`) are 500.7 for e = 500, 1010.7 for
+//! 1000 and 223 for 200: there the joint fit's cost itself is lowest near 220 (flat between
+//! 215 and 226), a bias of the broad lobe's fit (its top edge is 4.6 % off even at the true
+//! gloss, BENCHMARKS.md). Read the estimate as good to about 1 % at e >= 500 and 12 % at
+//! e = 200.
 //!
 //! # Limits
 //!
