@@ -87,8 +87,8 @@ pub struct ConvertOptions {
 
 impl ConvertOptions {
     /// The options `streaklight fit SCENE PHOTO -o OUTPUT` runs with: exposure 1, the default
-    /// samples, seed 1, the paper's G = 1, fallback quads, no report or pictures, the paper
-    /// method. Change fields with struct update syntax.
+    /// samples, seed 1, the paper's G = 1, fallback quads, no report or pictures, the joint
+    /// method with the scene's gloss. Change fields with struct update syntax.
     pub fn new(
         scene: impl Into<PathBuf>,
         photo: impl Into<PathBuf>,
