@@ -1270,15 +1270,10 @@ const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
 
 /// Tries to explain light k as two lights on its plane, side by side or one above the other
 /// (overlapping streaks merge into one region, METHOD §5 and the paper's §5.3): each
-/// candidate starts from the rectangle cut in half and is fitted coarsely. Returns the best
-/// candidate state and its cost when it beats `cost` by more than [`SPLIT_MIN_CHI2_DROP`].
-fn try_split(
-    problem: &Problem,
-    st: &State,
-    k: usize,
-    extents: &[Option<Rect>],
-    cost: f64,
-) -> Option<(State, f64)> {
+/// candidate starts from the rectangle cut in half and is fitted coarsely. Returns the
+/// candidate with the lowest row-summed cost when it is below
+/// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's.
+fn try_split(problem: &Problem, st: &State, k: usize, extents: &[Option<Rect>]) -> Option<State> {
     let r = st.rects[k];
     let halves = [
         // One above the other.
@@ -1305,7 +1300,7 @@ fn try_split(
         radiance.push(st.radiance[k]);
         let mut trial = problem.state(set_of, pinned, rects, radiance);
         problem.descend(&mut trial, extents, SPLIT_TRIAL_SWEEPS);
-        let c = problem.cost(&trial);
+        let c = problem.row_cost(&trial);
         let both_lit = [k, trial.rects.len() - 1]
             .iter()
             .all(|&j| trial.radiance[j].iter().any(|&l| l > 0.0));
@@ -1313,9 +1308,9 @@ fn try_split(
             best = Some((trial, c));
         }
     }
-    let _ = cost;
     let before = problem.row_cost(st);
-    best.filter(|(trial, _)| problem.row_cost(trial) < SPLIT_MIN_ROW_COST_RATIO * before)
+    best.filter(|(_, c)| *c < SPLIT_MIN_ROW_COST_RATIO * before)
+        .map(|(trial, _)| trial)
 }
 
 fn optimise(
@@ -1344,19 +1339,17 @@ fn optimise(
     );
     problem.descend(&mut st, &extents, sweeps);
     let dof = |lights: usize| (problem.n() * 3).saturating_sub(7 * lights).max(1) as f64;
-    let mut cost = problem.cost(&st);
     if split && problem.structured(&st) {
         for k in 0..start.len() {
-            if let Some((trial, c)) = try_split(problem, &st, k, &extents, cost) {
+            if let Some(trial) = try_split(problem, &st, k, &extents) {
                 st = trial;
-                cost = c;
             }
         }
         if st.rects.len() > start.len() {
             problem.descend(&mut st, &extents, sweeps);
-            cost = problem.cost(&st);
         }
     }
+    let cost = problem.cost(&st);
     let sigma2 = (cost / dof(st.rects.len())).max(f64::MIN_POSITIVE);
     let uncertainty = uncertainties(problem, &st, &extents);
     let lights = (0..st.rects.len())
