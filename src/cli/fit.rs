@@ -3,9 +3,8 @@
 use std::path::PathBuf;
 
 use streaklight::convert::{convert, describe, ConvertOptions, Method};
-use streaklight::optics::Shadowing;
-use streaklight::scene_in::LoadOptions;
 
+use super::scene_args::SceneArgs;
 use super::streak_args::StreakArgs;
 
 /// Arguments of `streaklight fit`.
@@ -30,9 +29,6 @@ pub struct Args {
     /// about 2-3 times slower).
     #[arg(long, value_name = "E|auto")]
     pub gloss: Option<GlossArg>,
-    /// Index of refraction of the water (default: its material's KHR_materials_ior, else 1.33).
-    #[arg(long)]
-    pub ior: Option<f32>,
     /// The photo's exposure: its linear values are divided by it to give radiance.
     #[arg(long, default_value_t = 1.0)]
     pub exposure: f32,
@@ -42,21 +38,9 @@ pub struct Args {
     /// Seed of every random number: the same inputs and seed give the same output.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Water node or mesh name (default: the one mesh node whose name contains "water").
-    #[arg(long)]
-    pub water: Option<String>,
-    /// Camera node or camera name (default: the first camera of the default scene).
-    #[arg(long)]
-    pub camera: Option<String>,
     /// Do not add emissive fallback quads for viewers without area lights.
     #[arg(long)]
     pub no_fallback_quads: bool,
-    /// Light intensity units per unit of radiance (683 turns W/(sr m^2) into nits).
-    #[arg(long, default_value_t = 1.0)]
-    pub nits_scale: f64,
-    /// Use Smith shadowing in the reflection model (default: the paper's G = 1).
-    #[arg(long)]
-    pub smith: bool,
     /// How to fit: "joint" (the paper's per-streak estimate refined by fitting all lights
     /// together to every water pixel that can see them, splitting a light whose streak holds
     /// two, with per-parameter uncertainties in the report) or "paper" (the per-streak
@@ -66,6 +50,9 @@ pub struct Args {
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]
     pub allow_empty: bool,
+    /// Camera, water and units.
+    #[command(flatten)]
+    pub scene_options: SceneArgs,
     /// Streak-extraction settings.
     #[command(flatten)]
     pub streak: StreakArgs,
@@ -79,24 +66,14 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         output: args.output,
         report: args.report,
         debug_dir: args.debug_dir,
-        load: LoadOptions {
-            camera: args.camera,
-            water: args.water,
-            gloss: match args.gloss {
-                Some(GlossArg::Value(e)) => Some(e),
-                _ => None,
-            },
-            ior: args.ior,
-            nits_scale: args.nits_scale,
-        },
+        load: args.scene_options.load_options(match args.gloss {
+            Some(GlossArg::Value(e)) => Some(e),
+            _ => None,
+        }),
         exposure: args.exposure,
         samples: args.samples,
         seed: args.seed,
-        shadowing: if args.smith {
-            Shadowing::Smith
-        } else {
-            Shadowing::None
-        },
+        shadowing: args.scene_options.shadowing(),
         fallback_quads: !args.no_fallback_quads,
         allow_empty: args.allow_empty,
         streak_params: args.streak.params()?,

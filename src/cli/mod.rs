@@ -3,5 +3,6 @@
 pub mod fit;
 pub mod render;
 pub mod samples;
+pub mod scene_args;
 pub mod segment;
 pub mod streak_args;

@@ -2,10 +2,11 @@
 
 use std::path::PathBuf;
 
-use streaklight::optics::Shadowing;
 use streaklight::render::{render, RenderOptions};
-use streaklight::scene_in::{self, LoadOptions};
+use streaklight::scene_in;
 use streaklight::{output_file, photo_out};
+
+use super::scene_args::SceneArgs;
 
 /// Arguments of `streaklight render`.
 #[derive(clap::Args)]
@@ -30,40 +31,19 @@ pub struct Args {
     /// Seed of every random number: the same seed gives the same image.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Camera node or camera name (default: the first camera of the default scene).
-    #[arg(long)]
-    pub camera: Option<String>,
-    /// Water node or mesh name (default: the one node whose name contains "water").
-    #[arg(long)]
-    pub water: Option<String>,
     /// Blinn-Phong gloss e of the water, overriding its material's roughness.
     #[arg(long)]
     pub gloss: Option<f32>,
-    /// Index of refraction of the water (default: its material's KHR_materials_ior, else 1.33).
-    #[arg(long)]
-    pub ior: Option<f32>,
-    /// Light intensity units per unit of radiance (METHOD §7).
-    #[arg(long, default_value_t = 1.0)]
-    pub nits_scale: f64,
-    /// Use Smith shadowing in the reflection model.
-    #[arg(long)]
-    pub smith: bool,
+    /// Camera, water and units.
+    #[command(flatten)]
+    pub scene_options: SceneArgs,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> streaklight::Result<()> {
     photo_out::ImageFormat::from_path(&args.output)?;
     output_file::ensure_not_an_input(&args.output, &[&args.scene])?;
-    let scene = scene_in::load(
-        &args.scene,
-        &LoadOptions {
-            camera: args.camera,
-            water: args.water,
-            gloss: args.gloss,
-            ior: args.ior,
-            nits_scale: args.nits_scale,
-        },
-    )?;
+    let scene = scene_in::load(&args.scene, &args.scene_options.load_options(args.gloss))?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -83,11 +63,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         samples_per_pixel: args.spp,
         exposure: args.exposure,
         seed: args.seed,
-        shadowing: if args.smith {
-            Shadowing::Smith
-        } else {
-            Shadowing::None
-        },
+        shadowing: args.scene_options.shadowing(),
         progress: true,
     };
     let image = render(&scene, &options)?;

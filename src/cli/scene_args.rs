@@ -1,0 +1,47 @@
+//! The scene options `fit` and `render` share: which camera and water, the water's optics
+//! (the gloss stays with each command: `fit` also takes "auto"), and the light units.
+
+use streaklight::optics::Shadowing;
+use streaklight::scene_in::LoadOptions;
+
+/// Scene options shared by `fit` and `render`.
+#[derive(clap::Args)]
+pub struct SceneArgs {
+    /// Camera node or camera name (default: the first camera of the default scene).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Water node or mesh name (default: the one mesh node whose name contains "water").
+    #[arg(long)]
+    pub water: Option<String>,
+    /// Index of refraction of the water (default: its material's KHR_materials_ior, else 1.33).
+    #[arg(long)]
+    pub ior: Option<f32>,
+    /// Light intensity units per unit of radiance (683 turns W/(sr m^2) into nits).
+    #[arg(long, default_value_t = 1.0)]
+    pub nits_scale: f64,
+    /// Use Smith shadowing in the reflection model (default: the paper's G = 1).
+    #[arg(long)]
+    pub smith: bool,
+}
+
+impl SceneArgs {
+    /// How to load the scene, with the water's gloss `gloss` (`None`: its material's).
+    pub fn load_options(&self, gloss: Option<f32>) -> LoadOptions {
+        LoadOptions {
+            camera: self.camera.clone(),
+            water: self.water.clone(),
+            gloss,
+            ior: self.ior,
+            nits_scale: self.nits_scale,
+        }
+    }
+
+    /// The reflection model's shadowing term.
+    pub fn shadowing(&self) -> Shadowing {
+        if self.smith {
+            Shadowing::Smith
+        } else {
+            Shadowing::None
+        }
+    }
+}
