@@ -47,9 +47,8 @@ fn estimate(scene: &Scene, photo_name: &str) -> (GlossEstimate, usize, f64) {
 
 /// Within 10 % of the rendered gloss on all three photos, from the scene's gloss of 500 (so
 /// a factor 2.5 too high for gloss200.png and 2 too low for gloss1000.png). gloss1000.png
-/// segments into two streaks: the paper fit merges them into one light. The issue asks 10 %;
-/// e = 200 comes out 223 (+11.7 %: the joint fit's cost is lowest there, flat between 215
-/// and 226), so it is held to 15 % and the shortfall stated in the issue note.
+/// segments into two streaks: the paper fit merges them into one light. Measured: 205.6,
+/// 500.8 and 1001.2.
 #[test]
 fn estimates_the_gloss_of_the_sample_photos() {
     let scene = sample_scene("scene.gltf", None);
@@ -62,7 +61,7 @@ fn estimates_the_gloss_of_the_sample_photos() {
     let truth = samples::table1_light();
     let mut failures = Vec::new();
     for (photo, gloss, tolerance) in [
-        ("gloss200.png", 200.0f32, 0.15),
+        ("gloss200.png", 200.0f32, 0.1),
         ("table1.png", 500.0, 0.1),
         ("gloss1000.png", 1000.0, 0.1),
     ] {
