@@ -407,10 +407,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             &photo,
             &water,
             &observations,
-            &GlossSearch {
-                fit: fit_options,
-                ..GlossSearch::for_scene(&scene)
-            },
+            &GlossSearch::starting_from(fit_options),
         )?;
         gloss = (
             estimate.gloss,
