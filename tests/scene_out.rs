@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 mod common;
 
 use base64::Engine;
-use common::gltf_check::validator_problems;
+use common::gltf_check::{load, resolve, validator_problems, Doc};
 use glam::{DQuat, DVec3};
 use serde_json::{json, Value};
 use streaklight::scene_out::{
@@ -252,71 +252,8 @@ fn real_inputs(dir: &Path) -> Vec<PathBuf> {
 // ---------------------------------------------------------------------------------------------
 // Reading documents back, independently of the writer
 
-struct Loaded {
-    json: Value,
-    buffers: Vec<Vec<u8>>,
-    glb_chunks: Vec<(u32, Vec<u8>)>,
-}
-
-/// The file a relative URI points at, from the document at `doc`.
-fn resolve(doc: &Path, uri: &str) -> Option<PathBuf> {
-    if uri.starts_with("data:") {
-        return None;
-    }
-    Some(
-        doc.parent()
-            .unwrap()
-            .join(streaklight::scene_in::document::percent_decode(uri)),
-    )
-}
-
-/// Reads a .gltf/.glb and every buffer it refers to (data URIs, files, the BIN chunk).
-fn load(path: &Path) -> Loaded {
-    let bytes = std::fs::read(path).unwrap();
-    let (json, bin, glb_chunks) = if bytes.starts_with(b"glTF") {
-        let total = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
-        assert_eq!(total, bytes.len(), "GLB length field");
-        let mut at = 12;
-        let mut chunks = Vec::new();
-        while at < bytes.len() {
-            let len = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-            let kind = u32::from_le_bytes(bytes[at + 4..at + 8].try_into().unwrap());
-            assert_eq!(len % 4, 0, "chunk length must be a multiple of 4");
-            chunks.push((kind, bytes[at + 8..at + 8 + len].to_vec()));
-            at += 8 + len;
-        }
-        let json: Value = serde_json::from_slice(&chunks[0].1).unwrap();
-        let bin = chunks
-            .get(1)
-            .filter(|c| c.0 == 0x004E_4942)
-            .map(|c| c.1.clone());
-        (json, bin, chunks)
-    } else {
-        (serde_json::from_slice(&bytes).unwrap(), None, Vec::new())
-    };
-    let mut buffers = Vec::new();
-    for b in json["buffers"].as_array().into_iter().flatten() {
-        let len = b["byteLength"].as_u64().unwrap() as usize;
-        let data = match b["uri"].as_str() {
-            None => bin.clone().expect("buffer without uri needs a BIN chunk"),
-            Some(uri) if uri.starts_with("data:") => base64::engine::general_purpose::STANDARD
-                .decode(&uri[uri.find(',').unwrap() + 1..])
-                .unwrap(),
-            Some(uri) => std::fs::read(resolve(path, uri).unwrap())
-                .unwrap_or_else(|e| panic!("{}: buffer {uri}: {e}", path.display())),
-        };
-        assert!(data.len() >= len, "buffer shorter than its byteLength");
-        buffers.push(data[..len].to_vec());
-    }
-    Loaded {
-        json,
-        buffers,
-        glb_chunks,
-    }
-}
-
 /// Positions of every primitive of meshes `0..count`, read with the `gltf` crate.
-fn positions(loaded: &Loaded, count: usize) -> Vec<Vec<[f32; 3]>> {
+fn positions(loaded: &Doc, count: usize) -> Vec<Vec<[f32; 3]>> {
     let bytes = serde_json::to_vec(&loaded.json).unwrap();
     let doc = gltf::Gltf::from_slice_without_validation(&bytes).unwrap();
     let mut out = Vec::new();
@@ -577,7 +514,7 @@ fn assert_lights_read_back(
 }
 
 fn assert_fallback_quad(
-    loaded: &Loaded,
+    loaded: &Doc,
     index: usize,
     light_node: &Value,
     want: &LightToWrite,

@@ -3,58 +3,75 @@
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use base64::Engine;
 use serde_json::Value;
 
-/// A document's JSON and the bytes of each of its buffers (data URIs, files, the BIN chunk).
+/// A document's JSON, the bytes of each of its buffers (data URIs, files, the BIN chunk), and
+/// for a .glb its chunks (type, bytes) as stored.
 pub struct Doc {
     pub json: Value,
     pub buffers: Vec<Vec<u8>>,
+    pub glb_chunks: Vec<(u32, Vec<u8>)>,
 }
 
-/// Reads a .gltf/.glb and every buffer it refers to.
+/// The file a relative URI points at, from the document at `doc`.
+pub fn resolve(doc: &Path, uri: &str) -> Option<PathBuf> {
+    if uri.starts_with("data:") {
+        return None;
+    }
+    Some(
+        doc.parent()
+            .unwrap()
+            .join(streaklight::scene_in::document::percent_decode(uri)),
+    )
+}
+
+/// Reads a .gltf/.glb and every buffer it refers to (data URIs, files, the BIN chunk).
 pub fn load(path: &Path) -> Doc {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let (json, bin): (Value, Option<Vec<u8>>) = if bytes.starts_with(b"glTF") {
+    let (json, bin, glb_chunks) = if bytes.starts_with(b"glTF") {
+        let total = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+        assert_eq!(total, bytes.len(), "GLB length field");
         let mut at = 12;
         let mut chunks = Vec::new();
-        while at + 8 <= bytes.len() {
+        while at < bytes.len() {
             let len = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
             let kind = u32::from_le_bytes(bytes[at + 4..at + 8].try_into().unwrap());
+            assert_eq!(len % 4, 0, "chunk length must be a multiple of 4");
             chunks.push((kind, bytes[at + 8..at + 8 + len].to_vec()));
             at += 8 + len;
         }
-        let json = serde_json::from_slice(&chunks[0].1).unwrap();
+        let json: Value = serde_json::from_slice(&chunks[0].1).unwrap();
         let bin = chunks
             .get(1)
             .filter(|c| c.0 == 0x004E_4942)
             .map(|c| c.1.clone());
-        (json, bin)
+        (json, bin, chunks)
     } else {
-        (serde_json::from_slice(&bytes).unwrap(), None)
+        (serde_json::from_slice(&bytes).unwrap(), None, Vec::new())
     };
     let mut buffers = Vec::new();
     for b in json["buffers"].as_array().into_iter().flatten() {
         let len = b["byteLength"].as_u64().unwrap() as usize;
         let data = match b["uri"].as_str() {
-            None => bin.clone().expect("a buffer without uri needs a BIN chunk"),
+            None => bin.clone().expect("buffer without uri needs a BIN chunk"),
             Some(uri) if uri.starts_with("data:") => base64::engine::general_purpose::STANDARD
                 .decode(&uri[uri.find(',').unwrap() + 1..])
                 .unwrap(),
-            Some(uri) => std::fs::read(
-                path.parent()
-                    .unwrap()
-                    .join(streaklight::scene_in::document::percent_decode(uri)),
-            )
-            .unwrap_or_else(|e| panic!("{}: buffer {uri}: {e}", path.display())),
+            Some(uri) => std::fs::read(resolve(path, uri).unwrap())
+                .unwrap_or_else(|e| panic!("{}: buffer {uri}: {e}", path.display())),
         };
         assert!(data.len() >= len, "buffer shorter than its byteLength");
         buffers.push(data[..len].to_vec());
     }
-    Doc { json, buffers }
+    Doc {
+        json,
+        buffers,
+        glb_chunks,
+    }
 }
 
 /// Every value of `a` is present and equal at the same path in `b` (objects may gain keys,
