@@ -53,6 +53,6 @@ mod shadowing;
 pub use coefficient::reflection_coefficient;
 pub use frame::orthonormal_basis;
 pub use fresnel::{fresnel_dielectric, fresnel_dielectric_sp};
-pub use lobe::{LobeSample, ReflectionModel};
+pub use lobe::{compact_strata, LobeSample, ReflectionModel};
 pub use microfacet::{blinn_phong_d, cone_cos_theta, CONE_LOST_MASS};
 pub use shadowing::{beckmann_alpha, energy_cap, smith_g1, Shadowing};
