@@ -153,6 +153,12 @@ impl WaterPoint {
         let sample = model.sample(self.normal, self.wo, u)?;
         (self.face.dot(sample.wi) > 0.0).then_some(sample)
     }
+
+    /// The direction of [`reflect`](Self::reflect)'s sample for `u`, without its weight.
+    pub fn reflect_direction(&self, model: &ReflectionModel, u: Vec2) -> Option<Vec3> {
+        let wi = model.direction(self.normal, self.wo, u)?;
+        (self.face.dot(wi) > 0.0).then_some(wi)
+    }
 }
 
 /// What a camera ray sees first.

@@ -140,12 +140,12 @@ fn exr_and_png_of_one_render_both_fit_table1_and_the_exr_is_no_worse() {
     for (name, e) in [("EXR", &exr_errors), ("PNG", &png_errors)] {
         assert!(
             // Three times the joint fit's own-sample rms on this light (tests/joint.rs).
-            e.largest_edge() < 0.025,
+            e.largest_edge() < 0.01,
             "{name}: an edge is off by {:.3} % of the size",
             100.0 * e.largest_edge()
         );
         assert!(
-            e.largest_radiance() < 0.025,
+            e.largest_radiance() < 0.01,
             "{name}: the radiance is off by {:.3} %",
             100.0 * e.largest_radiance()
         );

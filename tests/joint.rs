@@ -95,8 +95,9 @@ fn percent(e: [f64; 4]) -> [f64; 4] {
 /// Measured with 24 seeds of the fit's samples on one Table 3 render (BENCHMARKS.md), the
 /// root mean square errors in % of the light's size, and the bounds held here, three times
 /// those (a fixed seed's result is one draw; the bounds must not rest on a lucky one):
-/// light0 (as Table 1) worst edge 0.75 %, radiance 0.82 %: held to 2.5 %.
-const LIGHT0_BOUND: f64 = 0.025;
+/// light0 worst edge 0.22 % (Table 3) and 0.29 % (Table 1), radiance 0.27 % and 0.34 %:
+/// held to 1 %. (Before the samples were spread over kernels: 0.75 % and 0.82 %.)
+const LIGHT0_BOUND: f64 = 0.01;
 
 /// Table 1 (one light, fully in the photo): every edge and the radiance within
 /// [`LIGHT0_BOUND`], and the reported uncertainties cover the errors.
@@ -139,8 +140,8 @@ fn joint_fits_table1() {
 /// seen at all: the fit keeps it where the paper method put it (the lobes' farthest reach)
 /// and reports it unconstrained. Its other edges and radiance are seen only through the
 /// 40-70 pixel wide strip left of the border, where height and radiance trade against each
-/// other, so the fit's own noise moves them more: rms over 24 seeds 0.18 % (left), 0.89 %
-/// (bottom), 1.70 % (top), 2.07 % (radiance); held to three times that, as light0.
+/// other, so the fit's own noise moves them more: rms over 24 seeds 0.08 % (left), 0.93 %
+/// (bottom), 1.93 % (top), 2.38 % (radiance); held to three times that, as light0.
 #[test]
 fn joint_fits_table3() {
     let truths = samples::table3_lights();
@@ -169,9 +170,9 @@ fn joint_fits_table3() {
     );
     assert_eq!(joint[0].radiance[2], 0.0, "light0 has no blue");
     for (side, e, tol) in [
-        ("left", e1[0], 0.0055),
-        ("bottom", e1[2], 0.027),
-        ("top", e1[3], 0.051),
+        ("left", e1[0], 0.0025),
+        ("bottom", e1[2], 0.028),
+        ("top", e1[3], 0.058),
     ] {
         assert!(
             e.abs() < tol,
@@ -179,7 +180,7 @@ fn joint_fits_table3() {
             100.0 * e
         );
     }
-    assert!(r1 < 0.062, "light1 radiance off by {:.3} %", 100.0 * r1);
+    assert!(r1 < 0.072, "light1 radiance off by {:.3} %", 100.0 * r1);
     // Uncertainties: light0's errors within 5 sigma (as Table 1). Light1's spread is measured
     // from one pair of half-sample refits, which can come out small by chance (over 8 seeds
     // its top edge's error reached 12 sigma once), so its sigmas are printed, not held.

@@ -67,6 +67,26 @@ impl ReflectionModel {
     /// the surface (`n.wi <= 0`). Those samples count as zero in every estimate.
     #[inline]
     pub fn sample(&self, n: Vec3, wo: Vec3, u: Vec2) -> Option<LobeSample> {
+        let m = self.mirror(n, wo, u)?;
+        let fresnel = fresnel_dielectric(m.cos_oh, self.ior);
+        let g = self
+            .shadowing
+            .g(self.gloss, m.cos_o, m.cos_i, m.cos_h, m.cos_oh, fresnel);
+        // f (n.wi) / pdf(wi) with pdf(wi) = D (n.h) / (4 (wo.h) KEEP): D cancels.
+        let weight = KEEP * fresnel * g * m.cos_oh / (m.cos_o * m.cos_h);
+        Some(LobeSample { wi: m.wi, weight })
+    }
+
+    /// The direction [`sample`](Self::sample) returns for the same arguments, without its
+    /// weight: for neighbouring directions, where only the geometry is wanted.
+    #[inline]
+    pub fn direction(&self, n: Vec3, wo: Vec3, u: Vec2) -> Option<Vec3> {
+        self.mirror(n, wo, u).map(|m| m.wi)
+    }
+
+    /// `wo` mirrored about the half vector drawn from `u` (see [`sample`](Self::sample)).
+    #[inline]
+    fn mirror(&self, n: Vec3, wo: Vec3, u: Vec2) -> Option<Mirrored> {
         let cos_o = n.dot(wo);
         if cos_o <= 0.0 {
             return None;
@@ -89,13 +109,13 @@ impl ReflectionModel {
         if cos_i <= 0.0 {
             return None;
         }
-        let fresnel = fresnel_dielectric(cos_oh, self.ior);
-        let g = self
-            .shadowing
-            .g(self.gloss, cos_o, cos_i, cos_h, cos_oh, fresnel);
-        // f (n.wi) / pdf(wi) with pdf(wi) = D (n.h) / (4 (wo.h) KEEP): D cancels.
-        let weight = KEEP * fresnel * g * cos_oh / (cos_o * cos_h);
-        Some(LobeSample { wi, weight })
+        Some(Mirrored {
+            wi,
+            cos_o,
+            cos_h,
+            cos_oh,
+            cos_i,
+        })
     }
 
     /// `f(wo, wi) (n.wi)`: the BRDF times the cosine at the light, 0 when either direction is
@@ -162,6 +182,15 @@ impl ReflectionModel {
             cos_oh: wo.dot(h),
         })
     }
+}
+
+/// A drawn direction and the cosines its weight needs.
+struct Mirrored {
+    wi: Vec3,
+    cos_o: f32,
+    cos_h: f32,
+    cos_oh: f32,
+    cos_i: f32,
 }
 
 struct HalfVector {
