@@ -17,9 +17,11 @@
 //! set of lobe samples, in two independent halves whose difference measures the estimate's
 //! noise. The samples that land on each light's plane inside its region of interest are
 //! traced ONCE; afterwards `c_k(p; rect)` for any rectangle is a sum over stored samples, so
-//! the optimisation traces no ray. The stored samples are common random numbers across all
-//! parameter values, so the cost is a deterministic function of the rectangles, and the
-//! coefficients' own noise is removed from it (see the note on the coefficients' noise).
+//! the optimisation traces no ray. Each sample spreads its weight over a small kernel sized by
+//! its lobe cell, so that a coefficient changes smoothly with the rectangle's edges (see the
+//! note on the cells). The stored samples are common random numbers across all parameter
+//! values, so the cost is a deterministic function of the rectangles, and the coefficients'
+//! own noise is removed from it (see the note on the coefficients' noise).
 //!
 //! The model is linear in the radiances: given the rectangles they are a nonnegative least
 //! squares solve per channel. The edges are found by coordinate descent where each 1D step
@@ -139,7 +141,8 @@ struct PlaneSamples {
     /// Per pixel, the bounding box of its samples' cells (empty pixels: an inverted box).
     bbox: Vec<Rect>,
     points: Vec<Vec2>,
-    /// Per sample, the half-extents of its cell on the plane (see [`cell_half_extents`]).
+    /// Per sample, the half-widths of its kernel along the plane's axes (see
+    /// [`cell_half_extents`] and the note on the cells).
     cells: Vec<Vec2>,
     weights: Vec<f32>,
 }
@@ -1191,7 +1194,7 @@ fn changed_strip(a: &Rect, b: &Rect) -> Option<Rect> {
 const POINT_CELL: f32 = 1e-6;
 
 /// One pixel's coefficient as a function of an edge's position on the grid
-/// `t_j = lo + j step`. Each sample's cell contributes a piecewise linear function of t: a
+/// `t_j = lo + j step`. Each sample's kernel contributes a piecewise linear function of t: a
 /// constant and ramps `s max(t - kink, 0)`. A ramp is accumulated at the first grid point
 /// past its kink as its slope `s` and `s kink`; after prefix sums the value at `t_j` is
 /// `constant + t_j sum s - sum s kink`, exact and one pass over the samples. Kept for the
@@ -1251,10 +1254,10 @@ impl EdgeRamps {
         }
     }
 
-    /// Adds a sample's cell `[x - h, x + h]` along the edge's axis with its weights (absolute,
-    /// signed) for a min edge (`min_edge`: the cell counts above the edge and below `opp`,
-    /// the opposite edge) or a max edge (below the edge and above `opp`). Returns whether it
-    /// counts anywhere.
+    /// Adds a sample's kernel of half-width h at x along the edge's axis ([`kernel_coverage`])
+    /// with its weights (absolute, signed) for a min edge (`min_edge`: the kernel counts above
+    /// the edge and below `opp`, the opposite edge) or a max edge (below the edge and above
+    /// `opp`). Returns whether it counts anywhere.
     fn add_cell(
         &mut self,
         min_edge: bool,
@@ -1297,6 +1300,7 @@ impl EdgeRamps {
         self.add_box(min_edge, x, h, opp, abs, signed)
     }
 
+    /// [`add_cell`](Self::add_cell) for one box of half-width h.
     fn add_box(&mut self, min_edge: bool, x: f32, h: f32, opp: f32, abs: f64, signed: f64) -> bool {
         let h = h.max(POINT_CELL) as f64;
         let (x, opp) = (x as f64, opp as f64);
