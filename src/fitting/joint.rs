@@ -1976,6 +1976,44 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_kernel_smooths_without_broadening_the_lobe() {
+        // Samples of a Gaussian lobe (sigma 1) jittered over a fine grid, each spread over a
+        // kernel of half-width h: the expected mass inside [lo, hi] is the lobe convolved with
+        // the kernel. A plain box of the same width adds its variance h^2/3 to the lobe's and
+        // errs at second order; the two-box kernel must err far less, and both keep the
+        // whole mass.
+        let gauss = |x: f64| (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt();
+        let (lo, hi) = (0.5f32, 3.0f32);
+        let lobe_mass = {
+            // Reference: the lobe's own mass inside [lo, hi], by fine quadrature.
+            let n = 200_000;
+            let dx = (hi - lo) as f64 / n as f64;
+            (0..n)
+                .map(|i| gauss(lo as f64 + (i as f64 + 0.5) * dx) * dx)
+                .sum::<f64>()
+        };
+        for h in [0.2f32, 0.4] {
+            let (mut kernel, mut boxed, mut total) = (0f64, 0f64, 0f64);
+            let n = 400_000;
+            let (a, b) = (-8.0f64, 8.0f64);
+            let dx = (b - a) / n as f64;
+            for i in 0..n {
+                let x = a + (i as f64 + 0.5) * dx;
+                let w = gauss(x) * dx;
+                kernel += w * kernel_coverage(x as f32, h, lo, hi) as f64;
+                boxed += w * coverage(x as f32, h, lo, hi) as f64;
+                total += w * kernel_coverage(x as f32, h, -100.0, 100.0) as f64;
+            }
+            let (kernel_err, box_err) = ((kernel - lobe_mass).abs(), (boxed - lobe_mass).abs());
+            assert!((total - 1.0).abs() < 1e-4, "mass {total}");
+            assert!(
+                kernel_err < 0.1 * box_err,
+                "h {h}: kernel error {kernel_err:.2e}, box {box_err:.2e}"
+            );
+        }
+    }
+
+    #[test]
     fn edge_ramps_match_the_kernels_mass_at_every_grid_point() {
         // Random cells (some points, some wider than the grid, some cut by the opposite
         // edge) against the direct coverage sum, for both kinds of edge.
