@@ -153,11 +153,14 @@ fn check_output(options: &ConvertOptions) -> Result<()> {
     let inputs = [options.scene.as_path(), options.photo.as_path()];
     output_file::ensure_not_an_input(&options.output, &inputs)?;
     output_file::ensure_folder_exists(&options.output)?;
+    output_file::ensure_writable(&options.output)?;
     if let Some(report) = &options.report {
         output_file::ensure_not_an_input(report, &inputs)?;
         output_file::ensure_not_an_input(report, &[options.output.as_path()])?;
-        // Checked now, so a missing report folder cannot leave a scene written without it.
+        // Checked now, so a missing or read-only report folder cannot leave a scene written
+        // without its report.
         output_file::ensure_folder_exists(report)?;
+        output_file::ensure_writable(report)?;
     }
     Ok(())
 }

@@ -65,9 +65,26 @@ pub fn ensure_folder_exists(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes `bytes` to `path` atomically: into a temporary file in the same folder, flushed to
-/// disk, then renamed over `path`. A failure leaves no partial file behind.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+/// Refuses, before any work, an output whose folder does not let us create files (read-only
+/// folder or disk, no permission): found out only at the end, it would leave one output
+/// written and the next one not. Creates and removes the temporary file that
+/// [`write_atomically`] would use.
+pub fn ensure_writable(path: &Path) -> Result<()> {
+    let tmp = temporary_path(path)?;
+    match std::fs::File::create(&tmp) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&tmp);
+            Ok(())
+        }
+        Err(e) => Err(Error::output(
+            path,
+            format!("cannot create a file in its folder ({e})"),
+        )),
+    }
+}
+
+/// The temporary file beside `path` that [`write_atomically`] writes first.
+fn temporary_path(path: &Path) -> Result<PathBuf> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -84,7 +101,13 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(name);
     tmp_name.push(format!(".{}.tmp-streaklight", std::process::id()));
-    let tmp = dir.join(tmp_name);
+    Ok(dir.join(tmp_name))
+}
+
+/// Writes `bytes` to `path` atomically: into a temporary file in the same folder, flushed to
+/// disk, then renamed over `path`. A failure leaves no partial file behind.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = temporary_path(path)?;
     let result = (|| -> std::io::Result<()> {
         let mut file = std::fs::File::create(&tmp)?;
         file.write_all(bytes)?;
@@ -101,6 +124,31 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[cfg(unix)]
+    #[test]
+    fn refuses_an_output_in_a_folder_it_cannot_write() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = std::env::temp_dir().join(format!("streaklight-ro-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("out.json");
+        assert!(ensure_writable(&path).is_ok());
+        assert!(
+            std::fs::read_dir(&dir).unwrap().next().is_none(),
+            "probe left behind"
+        );
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+        // Root writes anywhere: then there is nothing to refuse.
+        let root = std::fs::write(dir.join("probe"), b"x").is_ok();
+        let result = ensure_writable(&path);
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+        if !root {
+            let message = result.expect_err("read-only folder").to_string();
+            assert!(message.contains("out.json"), "{message}");
+            assert!(message.contains("cannot create a file"), "{message}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn refuses_output_equal_to_input_spelled_differently() {

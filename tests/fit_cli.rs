@@ -365,6 +365,39 @@ fn read_only_output_folder_is_refused() {
         );
         assert!(fit_case::listing(&ro).is_empty(), "{stderr}");
         assert_eq!(fit_case::listing(&dir), before, "{stderr}");
+
+        // A read-only report folder: refused before the fit, so no scene is written without
+        // its report (the scene's folder open to everyone, whoever runs the command).
+        use std::os::unix::fs::PermissionsExt;
+        let open = dir.join("open");
+        std::fs::create_dir(&open).unwrap();
+        std::fs::set_permissions(&open, std::fs::Permissions::from_mode(0o777)).unwrap();
+        let before = fit_case::listing(&dir);
+        let args = fit_args(
+            &scene,
+            &photo,
+            &open.join("out.gltf"),
+            &ro.join("report.json"),
+            &[],
+        );
+        let mut cmd = if as_root {
+            let mut c = std::process::Command::new(setpriv);
+            c.args(["--reuid=65534", "--regid=65534", "--clear-groups", bin]);
+            c
+        } else {
+            std::process::Command::new(bin)
+        };
+        let o = cmd.args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        eprintln!("refused: {}", stderr.trim_end());
+        assert!(!o.status.success(), "{stderr}");
+        assert!(
+            stderr.contains("report.json") && stderr.contains("Permission denied"),
+            "{stderr}"
+        );
+        assert!(fit_case::listing(&ro).is_empty(), "{stderr}");
+        assert!(fit_case::listing(&open).is_empty(), "{stderr}");
+        assert_eq!(fit_case::listing(&dir), before, "{stderr}");
     }
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();

@@ -43,6 +43,9 @@ pub struct Args {
 pub fn run(args: Args) -> streaklight::Result<()> {
     photo_out::ImageFormat::from_path(&args.output)?;
     output_file::ensure_not_an_input(&args.output, &[&args.scene])?;
+    // Before the render, not after it: a folder that cannot take the image fails at once.
+    output_file::ensure_folder_exists(&args.output)?;
+    output_file::ensure_writable(&args.output)?;
     let scene = scene_in::load(&args.scene, &args.scene_options.load_options(args.gloss))?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
