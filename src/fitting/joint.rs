@@ -559,7 +559,13 @@ fn cell_half_extents(lobe: &LobeNeighbours, start: Vec3, plane: &LightPlane) -> 
         side(lobe.plus_x, lobe.minus_x),
         side(lobe.plus_y, lobe.minus_y),
     );
-    0.5 * KERNEL_SCALE * Vec2::new(a.x.hypot(b.x), a.y.hypot(b.y))
+    let half = 0.5 * KERNEL_SCALE * Vec2::new(a.x.hypot(b.x), a.y.hypot(b.y));
+    // A neighbour grazing the plane lands at infinity: that sample stays a point.
+    if half.is_finite() {
+        half
+    } else {
+        Vec2::ZERO
+    }
 }
 
 /// How far from a sample, in strata, [`LobeNeighbours`] looks.
