@@ -345,19 +345,23 @@ fn read_only_output_folder_is_refused() {
             &dir.join("report.json"),
             &[],
         );
-        let bin = env!("CARGO_BIN_EXE_streaklight");
-        let mut cmd = if as_root {
-            let mut c = std::process::Command::new(setpriv);
-            c.args(["--reuid=65534", "--regid=65534", "--clear-groups", bin]);
-            c
-        } else {
-            std::process::Command::new(bin)
+        let refusal = |args: &[String]| {
+            let bin = env!("CARGO_BIN_EXE_streaklight");
+            let mut cmd = if as_root {
+                let mut c = std::process::Command::new(setpriv);
+                c.args(["--reuid=65534", "--regid=65534", "--clear-groups", bin]);
+                c
+            } else {
+                std::process::Command::new(bin)
+            };
+            let o = cmd.args(args).output().unwrap();
+            let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+            eprintln!("refused: {}", stderr.trim_end());
+            assert!(!o.status.success(), "{stderr}");
+            assert!(!stderr.contains("panicked"), "{stderr}");
+            stderr
         };
-        let o = cmd.args(&args).output().unwrap();
-        let stderr = String::from_utf8_lossy(&o.stderr);
-        eprintln!("refused: {}", stderr.trim_end());
-        assert!(!o.status.success(), "{stderr}");
-        assert!(!stderr.contains("panicked"), "{stderr}");
+        let stderr = refusal(&args);
         assert!(
             stderr.contains(&format!("{}/out.", ro.display()))
                 && stderr.contains("Permission denied"),
@@ -380,17 +384,7 @@ fn read_only_output_folder_is_refused() {
             &ro.join("report.json"),
             &[],
         );
-        let mut cmd = if as_root {
-            let mut c = std::process::Command::new(setpriv);
-            c.args(["--reuid=65534", "--regid=65534", "--clear-groups", bin]);
-            c
-        } else {
-            std::process::Command::new(bin)
-        };
-        let o = cmd.args(&args).output().unwrap();
-        let stderr = String::from_utf8_lossy(&o.stderr);
-        eprintln!("refused: {}", stderr.trim_end());
-        assert!(!o.status.success(), "{stderr}");
+        let stderr = refusal(&args);
         assert!(
             stderr.contains("report.json") && stderr.contains("Permission denied"),
             "{stderr}"
