@@ -83,6 +83,10 @@ pub struct ConvertOptions {
     /// Estimate the water's gloss from the photo together with the lights (`--gloss auto`;
     /// the scene's or `load.gloss` is the search's start). Implies the joint fit.
     pub estimate_gloss: bool,
+    /// Independent joint fits, each from its own samples, whose mean is the result (at least
+    /// 1; see [`JointOptions::repeats`]): N times slower, with uncertainties that hold where
+    /// one fit's understate them (a light seen only through an overlap or a cut streak).
+    pub repeats: u32,
 }
 
 impl ConvertOptions {
@@ -110,6 +114,7 @@ impl ConvertOptions {
             streak_params: StreakParams::default(),
             method: Method::default(),
             estimate_gloss: false,
+            repeats: 1,
         }
     }
 }
@@ -410,7 +415,10 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             &photo,
             &water,
             &observations,
-            &GlossSearch::starting_from(fit_options),
+            &GlossSearch {
+                final_repeats: options.repeats,
+                ..GlossSearch::starting_from(fit_options)
+            },
         )?;
         gloss = (
             estimate.gloss,
@@ -445,7 +453,10 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
                 &water,
                 &observations,
                 &f.lights,
-                &JointOptions::new(fit_options.model, options.seed),
+                &JointOptions {
+                    repeats: options.repeats,
+                    ..JointOptions::new(fit_options.model, options.seed)
+                },
             )?;
             f.timings.extend(
                 refined
@@ -573,6 +584,10 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             },
             samples: options.samples,
             seed: options.seed,
+            repeats: match options.method {
+                Method::Joint => options.repeats,
+                Method::Paper => 1,
+            },
             exposure: options.exposure,
             nits_scale: options.load.nits_scale,
             method: options.method.name().into(),

@@ -52,6 +52,8 @@ pub struct Settings {
     pub samples: u32,
     /// Seed of every random number.
     pub seed: u64,
+    /// Independent joint fits averaged (1 for the paper method).
+    pub repeats: u32,
     /// Divisor applied to the photo's linear values.
     pub exposure: f32,
     /// Intensity units per unit of radiance in the written lights.

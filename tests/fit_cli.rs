@@ -163,6 +163,14 @@ fn photo_problems_are_refused() {
     fit_case::uniform_png(&close, 250, 249, 0);
     let msg = expect_refusal(&dir, &scene, &close, &[], &["close.png", "shows no streak"]);
     assert!(!msg.contains("aspect"), "{msg}");
+    // No joint fit at all.
+    expect_refusal(
+        &dir,
+        &scene,
+        &close,
+        &["--repeats", "0"],
+        &["--repeats", "0 is not in 1.."],
+    );
     // Missing.
     expect_refusal(
         &dir,

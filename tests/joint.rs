@@ -38,12 +38,18 @@ fn scenes() -> PathBuf {
 
 /// `streaklight fit` of a sample photo with a method; the report's lights.
 fn fit(photo: &str, method: Method) -> Vec<LightReport> {
+    fit_repeated(photo, method, 1)
+}
+
+/// [`fit`] with `repeats` independent joint fits averaged.
+fn fit_repeated(photo: &str, method: Method, repeats: u32) -> Vec<LightReport> {
     let dir = scenes();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let tag = format!("{}-{}", photo.replace('.', "_"), method.name());
+    let tag = format!("{}-{}-{repeats}", photo.replace('.', "_"), method.name());
     let options = ConvertOptions {
         exposure: samples::PHOTO_EXPOSURE,
         method,
+        repeats,
         ..ConvertOptions::new(
             dir.join("scene.gltf"),
             root.join("samples").join(photo),
@@ -228,6 +234,42 @@ fn joint_splits_overlapping_streaks() {
             c < centre && centre < c + light.height,
             "{c} + {} vs {centre}",
             light.height
+        );
+    }
+}
+
+/// Repeated joint fits of the stacked lights (`--repeats 4`). One fit's uncertainties leave
+/// out how far its samples move the lower light's top edge and radiance through the overlap:
+/// seed 1 (`--repeats 1`) is off by 4.8 % and 5.9 % at 13 and 11 sigma, so a pipeline would
+/// keep that light as sound. With 4 fits from independent samples their spread is in the
+/// uncertainties (over 8 seeds started from the truth: 0.5-1.9 sigma rms; one fit: up to 16),
+/// and seed 1 is within 5.1 sigma. What remains is a bias common to the fits (the lower light
+/// grows into the overlap: top +11 %, radiance -10 % for seed 1), which no spread of them
+/// shows. Held here: every parameter of both lights within 6 sigma (the one-fit report fails).
+#[test]
+fn repeated_fits_cover_the_stacked_errors() {
+    let truths = samples::stacked_lights();
+    let mut joint = fit_repeated("stacked.png", Method::Joint, 4);
+    assert_eq!(joint.len(), 2, "the joint fit splits the merged streak");
+    joint.sort_by(|a, b| a.corner_left_bottom[1].total_cmp(&b.corner_left_bottom[1]));
+    for (light, truth) in joint.iter().zip(&truths) {
+        let (z, z_rad) = sigmas(light, truth);
+        let (e, r) = errors(light, truth);
+        eprintln!(
+            "stacked x4: edges % {:?} radiance {:.3} %, sigmas {z:?} {z_rad:.2}",
+            percent(e),
+            100.0 * r
+        );
+        assert!(
+            z.iter().chain([&z_rad]).all(|&s| s < 6.0),
+            "errors beyond 6 sigma: {z:?} {z_rad}"
+        );
+        let u = light.uncertainty.as_ref().expect("uncertainty");
+        assert!(
+            [u.left, u.right, u.bottom, u.top]
+                .iter()
+                .all(|s| s.is_some()),
+            "every edge of a stacked light is seen"
         );
     }
 }

@@ -118,6 +118,9 @@ pub struct GlossSearch {
     /// Joint-fit samples per pixel of the final fit at the estimate (which runs the joint
     /// fit's default sweeps).
     pub final_samples: u32,
+    /// Independent final fits at the estimate whose mean is the result
+    /// ([`JointOptions::repeats`]).
+    pub final_repeats: u32,
 }
 
 /// Joint-fit samples per pixel of the search and of the final fit (module doc: the cost is
@@ -144,6 +147,7 @@ impl GlossSearch {
             search_samples: SEARCH_SAMPLES,
             search_sweeps: 6,
             final_samples: SEARCH_SAMPLES,
+            final_repeats: 1,
         }
     }
 
@@ -182,6 +186,9 @@ impl GlossSearch {
         }
         if self.search_samples == 0 || self.final_samples == 0 || self.fit.samples == 0 {
             return bad("the fits need at least one sample per pixel");
+        }
+        if self.final_repeats == 0 {
+            return bad("the final fit needs at least one repeat");
         }
         Ok(())
     }
@@ -337,6 +344,7 @@ pub fn estimate_gloss(
         &paper.lights,
         &JointOptions {
             samples: options.final_samples,
+            repeats: options.final_repeats,
             ..JointOptions::new(model_at(options, gloss), options.fit.seed)
         },
     )?;

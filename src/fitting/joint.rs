@@ -83,6 +83,11 @@ pub struct JointOptions {
     /// model's). Fits under different glosses are comparable only over the same pixels, so a
     /// gloss search fixes it to the broadest lobe it will try.
     pub region_gloss: Option<f32>,
+    /// Independent fits, each from its own samples, whose mean is the result (at least 1).
+    /// From 2 on, their spread replaces the half-sample estimate of how far the samples move
+    /// the fit ([`sample_spread`]), which understates it along weakly seen directions; the
+    /// mean's own error falls as one over the square root of the count.
+    pub repeats: u32,
 }
 
 impl JointOptions {
@@ -97,6 +102,7 @@ impl JointOptions {
             checkerboard: true,
             split: true,
             region_gloss: None,
+            repeats: 1,
         }
     }
 }
@@ -396,6 +402,7 @@ fn trace_samples(
     height: u32,
     samples: u32,
     seed: u64,
+    repeat: u32,
 ) -> (Vec<PlaneSamples>, u32) {
     type Hits = Vec<(u16, Vec2, Vec2, f32)>;
     let lobe = lobe_strata(samples);
@@ -403,7 +410,7 @@ fn trace_samples(
     let per_pixel: Vec<Hits> = pixels
         .par_iter()
         .map(|&pixel| {
-            let mut rng = Rng::new(seed, JOINT_STREAM | pixel as u64);
+            let mut rng = Rng::new(seed, JOINT_STREAM | (repeat as u64) << 32 | pixel as u64);
             let (x, y) = (pixel % width, pixel / width);
             let mut hits = Vec::new();
             let inv_c = 1.0 / CAMERA_STRATA as f32;
@@ -1475,30 +1482,94 @@ pub fn fit_joint(
         options.margin,
         options.checkerboard,
     );
-    let (stored, per_pixel_samples) = trace_samples(
-        scene,
-        &options.model,
-        &planes,
-        &roi,
-        &pixels,
-        photo.width,
-        photo.height,
-        options.samples,
-        options.seed,
-    );
-    let footprint_seconds = t0.elapsed().as_secs_f64();
-    let t1 = Instant::now();
-    let problem = Problem {
-        width: photo.width,
-        pixel_ids: pixels.clone(),
-        obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
-        clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
-        planes: stored,
-        inv_samples: 1.0 / per_pixel_samples as f32,
-        dev_scale: 1.0,
+    if options.repeats == 0 {
+        return Err(Error::Usage(
+            "the joint fit needs at least one repeat".into(),
+        ));
+    }
+    let problem_for = |repeat: u32| {
+        let (stored, per_pixel_samples) = trace_samples(
+            scene,
+            &options.model,
+            &planes,
+            &roi,
+            &pixels,
+            photo.width,
+            photo.height,
+            options.samples,
+            options.seed,
+            repeat,
+        );
+        Problem {
+            width: photo.width,
+            pixel_ids: pixels.clone(),
+            obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
+            clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
+            planes: stored,
+            inv_samples: 1.0 / per_pixel_samples as f32,
+            dev_scale: 1.0,
+        }
     };
-    let (lights, uncertainty, variance, cost) =
-        optimise(&problem, start, options.sweeps, options.split);
+    let problem = problem_for(0);
+    let mut footprint_seconds = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
+    let (first, replay) = optimise(&problem, start, &extents, options.sweeps, options.split);
+    let mut optimise_seconds = t1.elapsed().as_secs_f64();
+    let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
+    for repeat in 1..options.repeats {
+        let t = Instant::now();
+        let again = problem_for(repeat);
+        footprint_seconds += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let extents: Vec<Option<Rect>> = again.planes.iter().map(sample_extent).collect();
+        let st = again.replay(&replay, &extents, options.sweeps);
+        repeats.push((st.rects, st.radiance));
+        optimise_seconds += t.elapsed().as_secs_f64();
+    }
+    let t2 = Instant::now();
+    let (st, spread) = if repeats.len() == 1 {
+        let spread = sample_spread(&problem, &first, &extents);
+        (first, spread)
+    } else {
+        let (rects, radiance, spread) = mean_and_spread(&repeats);
+        let st = problem.state(
+            first.set_of.clone(),
+            first.pinned.clone(),
+            rects,
+            radiance.clone(),
+        );
+        // The mean's radiances, not the ones the first fit's samples would give its edges.
+        (State { radiance, ..st }, spread)
+    };
+    let cost = problem.cost(&st);
+    let dof = (problem.n() * 3).saturating_sub(7 * st.rects.len()).max(1) as f64;
+    let variance = (cost / dof).max(f64::MIN_POSITIVE);
+    let uncertainty = uncertainties(&problem, &st, &extents)
+        .into_iter()
+        .zip(spread)
+        .map(|(u, (edges, radiance))| Uncertainty {
+            edges: [0, 1, 2, 3].map(|e| u.edges[e].map(|sd| sd.hypot(edges[e]))),
+            radiance: [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c])),
+        })
+        .collect();
+    optimise_seconds += t2.elapsed().as_secs_f64();
+    let lights = (0..st.rects.len())
+        .map(|k| {
+            let origin = &start[st.set_of[k]];
+            let (r, rad) = (st.rects[k], st.radiance[k]);
+            FittedLight {
+                streak_ids: origin.streak_ids.clone(),
+                plane: origin.plane.clone(),
+                u_min: r.u_min,
+                u_max: r.u_max,
+                v_min: r.v_min,
+                v_max: r.v_max,
+                radiance: rad.map(|c| c as f32),
+                edges: origin.edges.clone(),
+            }
+        })
+        .collect();
     Ok(JointOutcome {
         lights,
         uncertainty,
@@ -1507,9 +1578,47 @@ pub fn fit_joint(
         cost,
         timings: vec![
             ("footprints".into(), footprint_seconds),
-            ("optimise".into(), t1.elapsed().as_secs_f64()),
+            ("optimise".into(), optimise_seconds),
         ],
     })
+}
+
+/// Per light, the mean rectangle and radiance of several independent fits, and the standard
+/// error of each mean (edges in metres, radiance per channel): the fits' sample standard
+/// deviation over the square root of their count.
+#[allow(clippy::type_complexity)]
+fn mean_and_spread(
+    fits: &[(Vec<Rect>, Vec<[f64; 3]>)],
+) -> (Vec<Rect>, Vec<[f64; 3]>, Vec<([f32; 4], [f32; 3])>) {
+    let n = fits.len() as f64;
+    let lights = fits[0].0.len();
+    let mut rects = Vec::with_capacity(lights);
+    let mut radiance = Vec::with_capacity(lights);
+    let mut spread = Vec::with_capacity(lights);
+    let mean_and_error = |values: &[f64]| {
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean, (var / n).sqrt())
+    };
+    for k in 0..lights {
+        let edges = EdgeSide::ALL.map(|side| {
+            let values: Vec<f64> = fits.iter().map(|f| f.0[k].edge(side) as f64).collect();
+            mean_and_error(&values)
+        });
+        let channels = [0, 1, 2].map(|c| {
+            let values: Vec<f64> = fits.iter().map(|f| f.1[k][c]).collect();
+            mean_and_error(&values)
+        });
+        rects.push(Rect {
+            u_min: edges[0].0 as f32,
+            u_max: edges[1].0 as f32,
+            v_min: edges[2].0 as f32,
+            v_max: edges[3].0 as f32,
+        });
+        radiance.push(channels.map(|c| c.0));
+        spread.push((edges.map(|e| e.1 as f32), channels.map(|c| c.1 as f32)));
+    }
+    (rects, radiance, spread)
 }
 
 /// A light's rectangle clamped into the region its samples can see (an unconstrained edge
@@ -1647,7 +1756,12 @@ const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
 /// candidate starts from the rectangle cut in half and is fitted coarsely. Returns the
 /// candidate with the lowest row-summed cost when it is below
 /// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's.
-fn try_split(problem: &Problem, st: &State, k: usize, extents: &[Option<Rect>]) -> Option<State> {
+fn try_split(
+    problem: &Problem,
+    st: &State,
+    k: usize,
+    extents: &[Option<Rect>],
+) -> Option<(State, State)> {
     let r = st.rects[k];
     let halves = [
         // One above the other.
@@ -1661,7 +1775,7 @@ fn try_split(problem: &Problem, st: &State, k: usize, extents: &[Option<Rect>]) 
             r.with_edge(EdgeSide::Left, 0.5 * (r.u_min + r.u_max)),
         ),
     ];
-    let mut best: Option<(State, f64)> = None;
+    let mut best: Option<(State, State, f64)> = None;
     for (first, second) in halves {
         let mut set_of = st.set_of.clone();
         let mut pinned = st.pinned.clone();
@@ -1672,28 +1786,40 @@ fn try_split(problem: &Problem, st: &State, k: usize, extents: &[Option<Rect>]) 
         set_of.push(st.set_of[k]);
         pinned.push(st.pinned[k]);
         radiance.push(st.radiance[k]);
-        let mut trial = problem.state(set_of, pinned, rects, radiance);
+        let cut = problem.state(set_of, pinned, rects, radiance);
+        let mut trial = cut.clone();
         problem.descend(&mut trial, extents, SPLIT_TRIAL_SWEEPS);
         let c = problem.row_cost(&trial);
         let both_lit = [k, trial.rects.len() - 1]
             .iter()
             .all(|&j| trial.radiance[j].iter().any(|&l| l > 0.0));
-        if both_lit && best.as_ref().is_none_or(|(_, b)| c < *b) {
-            best = Some((trial, c));
+        if both_lit && best.as_ref().is_none_or(|(_, _, b)| c < *b) {
+            best = Some((trial, cut, c));
         }
     }
     let before = problem.row_cost(st);
-    best.filter(|(_, c)| *c < SPLIT_MIN_ROW_COST_RATIO * before)
-        .map(|(trial, _)| trial)
+    best.filter(|(_, _, c)| *c < SPLIT_MIN_ROW_COST_RATIO * before)
+        .map(|(trial, cut, _)| (trial, cut))
 }
 
+/// How a fit reached its optimum, for repeating it on other samples: the state its
+/// descent started from (the start, or the split it kept, cut but not yet fitted) and
+/// whether that was a split (whose trial descent a repeat runs too).
+struct Replay {
+    start: State,
+    split: bool,
+}
+
+/// Fits the lights from `start`: a descent, then a split of any light whose residual is
+/// structured (see [`try_split`]) and another descent. Returns the optimum and how it was
+/// reached.
 fn optimise(
     problem: &Problem,
     start: &[FittedLight],
+    extents: &[Option<Rect>],
     sweeps: u32,
     split: bool,
-) -> (Vec<FittedLight>, Vec<Uncertainty>, f64, f64) {
-    let extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
+) -> (State, Replay) {
     let mut st = problem.state(
         (0..start.len()).collect(),
         start
@@ -1706,51 +1832,51 @@ fn optimise(
             .collect(),
         start
             .iter()
-            .zip(&extents)
+            .zip(extents)
             .map(|(l, e)| clamp_to(l.rect(), *e))
             .collect(),
         start.iter().map(|l| l.radiance.map(f64::from)).collect(),
     );
-    problem.descend(&mut st, &extents, sweeps);
-    let dof = |lights: usize| (problem.n() * 3).saturating_sub(7 * lights).max(1) as f64;
+    let mut replay = Replay {
+        start: st.clone(),
+        split: false,
+    };
+    problem.descend(&mut st, extents, sweeps);
     if split && problem.structured(&st) {
+        let mut cut = st.clone();
         for k in 0..start.len() {
-            if let Some(trial) = try_split(problem, &st, k, &extents) {
+            if let Some((trial, trial_cut)) = try_split(problem, &st, k, extents) {
                 st = trial;
+                cut = trial_cut;
             }
         }
         if st.rects.len() > start.len() {
-            problem.descend(&mut st, &extents, sweeps);
+            replay = Replay {
+                start: cut,
+                split: true,
+            };
+            problem.descend(&mut st, extents, sweeps);
         }
     }
-    let cost = problem.cost(&st);
-    let sigma2 = (cost / dof(st.rects.len())).max(f64::MIN_POSITIVE);
-    let spread = sample_spread(problem, &st, &extents);
-    let uncertainty = uncertainties(problem, &st, &extents)
-        .into_iter()
-        .zip(spread)
-        .map(|(u, (edges, radiance))| Uncertainty {
-            edges: [0, 1, 2, 3].map(|e| u.edges[e].map(|sd| sd.hypot(edges[e]))),
-            radiance: [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c])),
-        })
-        .collect();
-    let lights = (0..st.rects.len())
-        .map(|k| {
-            let origin = &start[st.set_of[k]];
-            let (r, rad) = (st.rects[k], st.radiance[k]);
-            FittedLight {
-                streak_ids: origin.streak_ids.clone(),
-                plane: origin.plane.clone(),
-                u_min: r.u_min,
-                u_max: r.u_max,
-                v_min: r.v_min,
-                v_max: r.v_max,
-                radiance: rad.map(|c| c as f32),
-                edges: origin.edges.clone(),
-            }
-        })
-        .collect();
-    (lights, uncertainty, sigma2, cost)
+    (st, replay)
+}
+
+impl Problem {
+    /// The fit `replay` describes, on this problem's samples.
+    fn replay(&self, replay: &Replay, extents: &[Option<Rect>], sweeps: u32) -> State {
+        let from = &replay.start;
+        let mut st = self.state(
+            from.set_of.clone(),
+            from.pinned.clone(),
+            from.rects.clone(),
+            from.radiance.clone(),
+        );
+        if replay.split {
+            self.descend(&mut st, extents, SPLIT_TRIAL_SWEEPS);
+        }
+        self.descend(&mut st, extents, sweeps);
+        st
+    }
 }
 
 /// Sweeps of each half's refit in [`sample_spread`]: they start at the optimum with windows
