@@ -552,7 +552,9 @@ fn assert_fallback_quad(
         (size.x - want.width).abs() < 1e-6 * want.width
             && (size.y - want.height).abs() < 1e-6 * want.height
     );
-    assert_eq!((lo.z, hi.z), (0.0, 0.0));
+    // 2 cm in front of the light (towards -Z, where it emits), off the wall it sits on: a
+    // quad in the wall's plane would z-fight with it.
+    assert_eq!((lo.z, hi.z), (-0.02f32 as f64, -0.02f32 as f64));
     let idx: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
     assert_eq!(idx.len(), 6);
     for t in idx.chunks(3) {

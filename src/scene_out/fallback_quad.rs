@@ -1,5 +1,6 @@
 //! The fallback for viewers without area lights (METHOD §7): under each light node, an
-//! emissive one-sided quad of the light's size, facing where the light emits.
+//! emissive one-sided quad of the light's size, facing where the light emits, a little in
+//! front of the wall the light sits on ([`QUAD_LIFT`]).
 //!
 //! Binary layout of the new data (placed by the caller at a 4-byte aligned offset of some
 //! buffer): one vertex buffer view with `byteStride` 12 holding, per light, 4 positions then
@@ -55,10 +56,20 @@ pub(crate) fn bytes(lights: &[PreparedLight]) -> Vec<u8> {
     vertices
 }
 
-/// The quad's corners in the light node's frame: width along X, height along Y, centred.
+/// How far in front of the light (towards local -Z, where it emits) its quad sits, in metres.
+/// A fitted light lies on the wall it was found on, and a quad in the wall's own plane
+/// z-fights with it in every rasteriser: both depths round to the same value and the wall's
+/// texels show through in stripes. A 24-bit depth buffer with a 0.1 m near plane resolves
+/// about 6 mm at 100 m, so 2 cm keeps the quad in front out to well beyond the distances a
+/// photo's lights are fitted at, while no viewer can see the gap.
+pub(crate) const QUAD_LIFT: f32 = 0.02;
+
+/// The quad's corners in the light node's frame: width along X, height along Y, centred,
+/// [`QUAD_LIFT`] in front.
 fn corners(light: &PreparedLight) -> [[f32; 3]; 4] {
     let (x, y) = ((light.width / 2.0) as f32, (light.height / 2.0) as f32);
-    [[-x, -y, 0.0], [x, -y, 0.0], [x, y, 0.0], [-x, y, 0.0]]
+    let z = -QUAD_LIFT;
+    [[-x, -y, z], [x, -y, z], [x, y, z], [-x, y, z]]
 }
 
 /// Appends the buffer views, accessors, materials, meshes and quad nodes for `lights` to the
@@ -101,8 +112,8 @@ pub(crate) fn append(
     for (k, light) in lights.iter().enumerate() {
         let c = corners(light);
         // min/max must equal the stored f32 values exactly; f32 -> f64 is exact.
-        let min = [c[0][0] as f64, c[0][1] as f64, 0.0];
-        let max = [c[2][0] as f64, c[2][1] as f64, 0.0];
+        let min = [c[0][0] as f64, c[0][1] as f64, c[0][2] as f64];
+        let max = [c[2][0] as f64, c[2][1] as f64, c[2][2] as f64];
         let position = push(
             root,
             "accessors",
