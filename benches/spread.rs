@@ -1,0 +1,166 @@
+//! How far the joint fit's own samples move its result, and whether the report's
+//! uncertainties cover that: `streaklight fit` (the whole pipeline, `convert`) of committed
+//! sample photos with seeds 1..=N, each light's errors from the truth (root mean square and
+//! mean over the seeds) and each error in units of its reported sigma (rms and largest).
+//! One photo per case, so what scatters is the fit's samples, not the photo's noise.
+//!
+//! `cargo bench --bench spread` runs 8 seeds of Table 3 and the stacked sample with 1 and 4
+//! repeats (about 15 minutes on 2 cores). Environment: `SPREAD_SEEDS` (count), `SPREAD_REPEATS`
+//! (comma-separated, e.g. "1,4"), `SPREAD_CASES` (comma-separated photo names, e.g.
+//! "table1.png,table3.png,stacked.png").
+
+use std::path::{Path, PathBuf};
+
+use streaklight::convert::{convert, ConvertOptions, Method};
+use streaklight::report::LightReport;
+use streaklight::samples::{self, SampleLight};
+
+/// Per light: errors (left, right, bottom, top in % of the size, radiance in % of the truth's
+/// largest channel) and the same in sigmas (`None` where no uncertainty was reported).
+type Measure = ([f64; 5], [Option<f64>; 5]);
+
+fn measure(light: &LightReport, truth: &SampleLight) -> Measure {
+    let c = light.corner_left_bottom;
+    let edges = [
+        (c[0] - truth.corner.x) / truth.width,
+        (c[0] + light.width - truth.corner.x - truth.width) / truth.width,
+        (c[1] - truth.corner.y) / truth.height,
+        (c[1] + light.height - truth.corner.y - truth.height) / truth.height,
+    ];
+    let ch = (0..3)
+        .max_by(|&a, &b| truth.radiance[a].total_cmp(&truth.radiance[b]))
+        .unwrap_or(0);
+    let rad = (light.radiance[ch] - truth.radiance[ch]) / truth.radiance[ch];
+    let errors = [edges[0], edges[1], edges[2], edges[3], rad];
+    let sigmas = match &light.uncertainty {
+        Some(u) => {
+            let metres = [
+                edges[0] * truth.width,
+                edges[1] * truth.width,
+                edges[2] * truth.height,
+                edges[3] * truth.height,
+            ];
+            let sd = [u.left, u.right, u.bottom, u.top];
+            let mut z = [None; 5];
+            for i in 0..4 {
+                z[i] = sd[i].filter(|s| *s > 0.0).map(|s| metres[i] / s);
+            }
+            z[4] = Some((light.radiance[ch] - truth.radiance[ch]) / u.radiance[ch]);
+            z
+        }
+        None => [None; 5],
+    };
+    (errors.map(|e| 100.0 * e), sigmas)
+}
+
+/// The truths of a committed sample photo.
+fn truths(photo: &str) -> Vec<SampleLight> {
+    match photo {
+        "table1.png" => vec![samples::table1_light()],
+        "table3.png" => samples::table3_lights(),
+        "stacked.png" => samples::stacked_lights(),
+        other => panic!("no truth for {other}: use table1.png, table3.png or stacked.png"),
+    }
+}
+
+fn env_list(name: &str, default: &str) -> Vec<String> {
+    std::env::var(name)
+        .unwrap_or_else(|_| default.to_owned())
+        .split(',')
+        .map(|s| s.trim().to_owned())
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
+}
+
+fn main() {
+    let seeds: u64 = std::env::var("SPREAD_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(8);
+    let repeats: Vec<u32> = env_list("SPREAD_REPEATS", "1,4")
+        .iter()
+        .map(|s| s.parse().expect("SPREAD_REPEATS: counts such as 1,4"))
+        .collect();
+    let cases = env_list("SPREAD_CASES", "table3.png,stacked.png");
+    let dir = std::env::temp_dir().join(format!("streaklight-spread-{}", std::process::id()));
+    samples::write_scenes(&dir).expect("writing the sample scenes");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    println!("seeds 1..={seeds}; errors in % of the size (edges) and of the radiance");
+    println!();
+    println!("| photo | repeats | light | rms error L, R, B, T; rad | mean error | rms sigmas | largest sigma | s per fit |");
+    println!("|---|---|---|---|---|---|---|---|");
+    for photo in &cases {
+        let truth = truths(photo);
+        for &r in &repeats {
+            let mut per_light: Vec<Vec<Measure>> = vec![Vec::new(); truth.len()];
+            let mut seconds = 0.0;
+            for seed in 1..=seeds {
+                let t = std::time::Instant::now();
+                let lights = fit(&dir, &root.join("samples").join(photo), seed, r);
+                seconds += t.elapsed().as_secs_f64();
+                for (k, t) in truth.iter().enumerate() {
+                    // The fitted light nearest the truth's centre.
+                    let nearest = lights
+                        .iter()
+                        .min_by(|a, b| distance(a, t).total_cmp(&distance(b, t)));
+                    if let Some(l) = nearest {
+                        per_light[k].push(measure(l, t));
+                    }
+                }
+            }
+            for (k, m) in per_light.iter().enumerate() {
+                let column = |i: usize| -> Vec<f64> { m.iter().map(|x| x.0[i]).collect() };
+                let zs = |i: usize| -> Vec<f64> { m.iter().filter_map(|x| x.1[i]).collect() };
+                let fmt = |f: &dyn Fn(usize) -> String| {
+                    format!("{}, {}, {}, {}; {}", f(0), f(1), f(2), f(3), f(4))
+                };
+                let rms_err = fmt(&|i| format!("{:.2}", rms(&column(i))));
+                let mean_err = fmt(&|i| {
+                    let c = column(i);
+                    format!("{:+.2}", c.iter().sum::<f64>() / c.len().max(1) as f64)
+                });
+                let rms_z = fmt(&|i| {
+                    let z = zs(i);
+                    if z.is_empty() {
+                        "-".into()
+                    } else {
+                        format!("{:.1}", rms(&z))
+                    }
+                });
+                let max_z = (0..5).flat_map(zs).map(f64::abs).fold(0.0, f64::max);
+                println!(
+                    "| {photo} | {r} | {} | {rms_err} | {mean_err} | {rms_z} | {max_z:.1} | {:.1} |",
+                    truth[k].name,
+                    seconds / seeds as f64
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn distance(light: &LightReport, truth: &SampleLight) -> f64 {
+    let c = light.corner_left_bottom;
+    let centre = truth.center();
+    (c[0] + light.width / 2.0 - centre.x).hypot(c[1] + light.height / 2.0 - centre.y)
+}
+
+/// `streaklight fit` of `photo` with `seed` and `repeats`: the report's lights.
+fn fit(dir: &Path, photo: &Path, seed: u64, repeats: u32) -> Vec<LightReport> {
+    let options = ConvertOptions {
+        exposure: samples::PHOTO_EXPOSURE,
+        method: Method::Joint,
+        seed,
+        repeats,
+        ..ConvertOptions::new(
+            dir.join("scene.gltf"),
+            photo,
+            dir.join(format!("spread-{seed}-{repeats}.gltf")),
+        )
+    };
+    convert(&options).expect("fit").report.lights
+}
