@@ -210,8 +210,9 @@ fn joint_fits_table3() {
 /// one's top 4.8 % and radiance 5.9 %: through the overlap the heights and radiances trade
 /// against each other, and over 8 seeds of the fit's samples (started from the truth) they
 /// scatter by 3-10 % rms; through the whole pipeline (`cargo bench --bench spread`) the lower
-/// light's top is 10 % too high on average. So only the split, the side edges (8-seed rms at most 0.23 %, held
-/// to 1 %) and the order are held here; the 2 % is not reached for both lights.
+/// light's top is 10 % too high on average. So only the split, the side edges (8-seed rms at
+/// most 0.23 %, held to 1 %) and the order are held here; the 2 % is not reached for
+/// both lights.
 #[test]
 fn joint_splits_overlapping_streaks() {
     let truths = samples::stacked_lights();
