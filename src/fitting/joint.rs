@@ -1438,6 +1438,11 @@ pub fn fit_joint(
             "the joint fit needs at least one sample per pixel".into(),
         ));
     }
+    if options.repeats == 0 {
+        return Err(Error::Usage(
+            "the joint fit needs at least one repeat".into(),
+        ));
+    }
     if start.is_empty() {
         return Ok(JointOutcome {
             lights: Vec::new(),
@@ -1482,11 +1487,6 @@ pub fn fit_joint(
         options.margin,
         options.checkerboard,
     );
-    if options.repeats == 0 {
-        return Err(Error::Usage(
-            "the joint fit needs at least one repeat".into(),
-        ));
-    }
     let problem_for = |repeat: u32| {
         let (stored, per_pixel_samples) = trace_samples(
             scene,
@@ -2144,6 +2144,39 @@ mod tests {
                 "h {h}: kernel error {kernel_err:.2e}, box {box_err:.2e}"
             );
         }
+    }
+
+    #[test]
+    fn repeats_give_their_mean_and_its_standard_error() {
+        let rect = |v: f32| Rect {
+            u_min: v,
+            u_max: v + 1.0,
+            v_min: 2.0 * v,
+            v_max: 3.0,
+        };
+        // Two fits: the standard error of their mean is half their difference, the
+        // convention of the half-sample spread.
+        let (rects, radiance, spread) = mean_and_spread(&[
+            (vec![rect(0.0)], vec![[1.0, 2.0, 3.0]]),
+            (vec![rect(0.5)], vec![[3.0, 2.0, 0.0]]),
+        ]);
+        assert_eq!(rects[0], rect(0.25));
+        assert_eq!(radiance[0], [2.0, 2.0, 1.5]);
+        assert_eq!(spread[0].0, [0.25, 0.25, 0.5, 0.0]);
+        assert_eq!(spread[0].1, [1.0, 0.0, 1.5]);
+        // Four: sample standard deviation over 2. Values 1, 2, 3, 6: mean 3, sd sqrt(14/3).
+        let fits: Vec<(Vec<Rect>, Vec<[f64; 3]>)> = [1.0, 2.0, 3.0, 6.0]
+            .iter()
+            .map(|&x| (vec![rect(0.0)], vec![[x, 0.0, 0.0]]))
+            .collect();
+        let (_, radiance, spread) = mean_and_spread(&fits);
+        assert_eq!(radiance[0][0], 3.0);
+        let expected = ((14.0f64 / 3.0).sqrt() / 2.0) as f32;
+        assert!(
+            (spread[0].1[0] - expected).abs() < 1e-6,
+            "{:?}",
+            spread[0].1
+        );
     }
 
     #[test]
