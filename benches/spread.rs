@@ -5,7 +5,7 @@
 //! One photo per case, so what scatters is the fit's samples, not the photo's noise.
 //!
 //! `cargo bench --bench spread` runs 8 seeds of Table 3 and the stacked sample with 1 and 4
-//! repeats (about 15 minutes on 2 cores). Environment: `SPREAD_SEEDS` (count), `SPREAD_REPEATS`
+//! repeats (about 8 minutes on 2 cores). Environment: `SPREAD_SEEDS` (count), `SPREAD_REPEATS`
 //! (comma-separated, e.g. "1,4"), `SPREAD_CASES` (comma-separated photo names, e.g.
 //! "table1.png,table3.png,stacked.png").
 
