@@ -87,6 +87,9 @@ pub struct ConvertOptions {
     /// 1; see [`JointOptions::repeats`]): N times slower, with uncertainties that hold where
     /// one fit's understate them (a light seen only through an overlap or a cut streak).
     pub repeats: u32,
+    /// Told a line as each stage of the run starts (None: silent). The CLI prints them, so a
+    /// long fit (`--gloss auto`, `--repeats`) shows where it is.
+    pub progress: Option<fn(&str)>,
 }
 
 impl ConvertOptions {
@@ -115,6 +118,7 @@ impl ConvertOptions {
             method: Method::default(),
             estimate_gloss: false,
             repeats: 1,
+            progress: None,
         }
     }
 }
@@ -128,10 +132,12 @@ pub struct ConvertOutcome {
     pub lights: Vec<FittedLight>,
 }
 
-struct Stopwatch(Vec<Timing>);
+/// Each stage's time, and whom to tell as one starts ([`ConvertOptions::progress`]).
+struct Stopwatch(Vec<Timing>, Option<fn(&str)>);
 
 impl Stopwatch {
     fn time<T>(&mut self, stage: &str, f: impl FnOnce() -> T) -> T {
+        self.say(stage);
         let start = Instant::now();
         let out = f();
         self.0.push(Timing {
@@ -139,6 +145,12 @@ impl Stopwatch {
             seconds: start.elapsed().as_secs_f64(),
         });
         out
+    }
+
+    fn say(&self, line: &str) {
+        if let Some(progress) = self.1 {
+            progress(line);
+        }
     }
 }
 
@@ -363,7 +375,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
                 .into(),
         ));
     }
-    let mut clock = Stopwatch(Vec::new());
+    let mut clock = Stopwatch(Vec::new(), options.progress);
     let scene = clock.time("load scene", || {
         scene_in::load(&options.scene, &options.load)
     })?;
@@ -410,6 +422,10 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     let mut fit = if observations.is_empty() {
         None
     } else if options.estimate_gloss {
+        clock.say(&format!(
+            "gloss search and fit of {} streak(s) (each step a joint fit)",
+            observations.len()
+        ));
         let estimate = fitting::gloss::estimate_gloss(
             &scene,
             &photo,
@@ -436,6 +452,10 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             timings: estimate.timings,
         })
     } else {
+        clock.say(&format!(
+            "fit of {} streak(s): the paper's estimate",
+            observations.len()
+        ));
         Some(fitting::fit_paper(
             &scene,
             &photo,
@@ -447,6 +467,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     if let (Some(f), Method::Joint, false) = (fit.as_mut(), options.method, options.estimate_gloss)
     {
         if !f.lights.is_empty() {
+            clock.say(&format!("joint fit of {} light(s)", f.lights.len()));
             let refined = joint::fit_joint(
                 &scene,
                 &photo,
@@ -455,6 +476,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
                 &f.lights,
                 &JointOptions {
                     repeats: options.repeats,
+                    progress: options.progress,
                     ..JointOptions::new(fit_options.model, options.seed)
                 },
             )?;

@@ -138,10 +138,31 @@ fn good_input_fits_a_light_and_validates() {
             "scene.gltf"
         ]
     );
-    // Also as .glb.
+    // Each stage is announced as it starts, so a long run shows where it is.
+    for stage in [
+        "load scene",
+        "streaks",
+        "the paper's estimate",
+        "joint fit of 1 light(s)",
+    ] {
+        assert!(
+            stderr.contains(stage),
+            "no progress line {stage:?}: {stderr}"
+        );
+    }
+    // Also as .glb, with two repeats: the second announced, the count in the report.
     let glb = dir.join("out.glb");
-    let (ok, stderr) = run(&fit_args(&scene, &photo, &glb, &report, &[]));
+    let (ok, stderr) = run(&fit_args(
+        &scene,
+        &photo,
+        &glb,
+        &report,
+        &["--repeats", "2"],
+    ));
     assert!(ok, "{stderr}");
+    assert!(stderr.contains("joint fit: repeat 2 of 2"), "{stderr}");
+    let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(r["settings"]["repeats"], 2);
     gltf_check::assert_validator_clean(&glb);
 }
 

@@ -90,6 +90,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         },
         estimate_gloss: matches!(args.gloss, Some(GlossArg::Auto)),
         repeats: args.repeats,
+        progress: Some(|line| eprintln!("{line}")),
     };
     let outcome = convert(&options)?;
     for w in &outcome.report.warnings {

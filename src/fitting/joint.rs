@@ -88,6 +88,8 @@ pub struct JointOptions {
     /// the fit ([`sample_spread`]), which understates it along weakly seen directions; the
     /// mean's own error falls as one over the square root of the count.
     pub repeats: u32,
+    /// Told a line as each repeat starts, when there are several (None: silent).
+    pub progress: Option<fn(&str)>,
 }
 
 impl JointOptions {
@@ -103,6 +105,7 @@ impl JointOptions {
             split: true,
             region_gloss: None,
             repeats: 1,
+            progress: None,
         }
     }
 }
@@ -1518,6 +1521,13 @@ pub fn fit_joint(
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
     for repeat in 1..options.repeats {
+        if let Some(say) = options.progress {
+            say(&format!(
+                "joint fit: repeat {} of {} (independent samples)",
+                repeat + 1,
+                options.repeats
+            ));
+        }
         let t = Instant::now();
         let again = problem_for(repeat);
         footprint_seconds += t.elapsed().as_secs_f64();
