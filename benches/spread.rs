@@ -20,13 +20,7 @@ use streaklight::samples::{self, SampleLight};
 type Measure = ([f64; 5], [Option<f64>; 5]);
 
 fn measure(light: &LightReport, truth: &SampleLight) -> Measure {
-    let c = light.corner_left_bottom;
-    let edges = [
-        (c[0] - truth.corner.x) / truth.width,
-        (c[0] + light.width - truth.corner.x - truth.width) / truth.width,
-        (c[1] - truth.corner.y) / truth.height,
-        (c[1] + light.height - truth.corner.y - truth.height) / truth.height,
-    ];
+    let edges = truth.edge_errors(light.corner_left_bottom, light.width, light.height);
     let ch = (0..3)
         .max_by(|&a, &b| truth.radiance[a].total_cmp(&truth.radiance[b]))
         .unwrap_or(0);

@@ -11,13 +11,7 @@ use streaklight::samples::{self, SampleLight};
 /// Per edge (left, right, bottom, top), the error as a fraction of the light's size along
 /// that edge's axis; and the radiance error as a fraction of the largest channel.
 fn errors(light: &LightReport, truth: &SampleLight) -> ([f64; 4], f64) {
-    let c = light.corner_left_bottom;
-    let edges = [
-        (c[0] - truth.corner.x) / truth.width,
-        (c[0] + light.width - truth.corner.x - truth.width) / truth.width,
-        (c[1] - truth.corner.y) / truth.height,
-        (c[1] + light.height - truth.corner.y - truth.height) / truth.height,
-    ];
+    let edges = truth.edge_errors(light.corner_left_bottom, light.width, light.height);
     let peak = truth.radiance.iter().cloned().fold(0.0, f64::max);
     let rad = (0..3)
         .map(|i| (light.radiance[i] - truth.radiance[i]).abs() / peak)

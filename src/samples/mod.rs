@@ -76,6 +76,19 @@ impl SampleLight {
     pub fn center(&self) -> DVec3 {
         self.corner + DVec3::new(self.width / 2.0, self.height / 2.0, 0.0)
     }
+
+    /// A fitted light's error per edge (left, right, bottom, top) as a fraction of this
+    /// light's size along the edge's axis, from its left-bottom corner and size (on the same
+    /// wall, width along +x).
+    pub fn edge_errors(&self, corner_left_bottom: [f64; 3], width: f64, height: f64) -> [f64; 4] {
+        let c = corner_left_bottom;
+        [
+            (c[0] - self.corner.x) / self.width,
+            (c[0] + width - self.corner.x - self.width) / self.width,
+            (c[1] - self.corner.y) / self.height,
+            (c[1] + height - self.corner.y - self.height) / self.height,
+        ]
+    }
 }
 
 /// One sample scene file.
