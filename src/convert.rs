@@ -87,6 +87,11 @@ pub struct ConvertOptions {
     /// 1; see [`JointOptions::repeats`]): N times slower, with uncertainties that hold where
     /// one fit's understate them (a light seen only through an overlap or a cut streak).
     pub repeats: u32,
+    /// Lobe samples per pixel of the joint fit (`None`: its default,
+    /// [`joint::DEFAULT_JOINT_SAMPLES`], or under `--gloss auto` the final fit's
+    /// [`fitting::gloss::SEARCH_SAMPLES`]). More cost proportionally more time and leave less of
+    /// the fit's own noise in the result.
+    pub joint_samples: Option<u32>,
     /// Told a line as each stage of the run starts (None: silent). The CLI prints them, so a
     /// long fit (`--gloss auto`, `--repeats`) shows where it is.
     pub progress: Option<fn(&str)>,
@@ -118,6 +123,7 @@ impl ConvertOptions {
             method: Method::default(),
             estimate_gloss: false,
             repeats: 1,
+            joint_samples: None,
             progress: None,
         }
     }
@@ -363,12 +369,45 @@ fn skipped_report(s: &Skipped) -> SkippedStreak {
     }
 }
 
+/// One warning per streak that was fitted as several lights (overlapping reflections, split
+/// by the joint fit): the photo tells such lights apart only weakly, and their uncertainties
+/// understate it (BENCHMARKS.md, "Repeated fits": the stacked sample's lower light is off by
+/// 5-19 % in its top edge at 13-24 reported sigmas with one fit, 4-6 with four repeats).
+fn shared_streak_warnings(lights: &[LightReport]) -> Vec<String> {
+    let mut by_streak: std::collections::BTreeMap<usize, Vec<&str>> = Default::default();
+    for light in lights {
+        for &streak in &light.streak_ids {
+            by_streak.entry(streak).or_default().push(&light.name);
+        }
+    }
+    by_streak
+        .into_iter()
+        .filter(|(_, names)| names.len() > 1)
+        .map(|(streak, names)| {
+            format!(
+                "streak {streak} holds {} lights ({}), whose reflections overlap: the photo tells them \
+                 apart only weakly where they meet, so their facing edges and radiances may be off \
+                 by several percent (up to 20 % on the bundled stacked sample), several times \
+                 their reported uncertainties",
+                names.len(),
+                names.join(", ")
+            )
+        })
+        .collect()
+}
+
 /// Runs the whole conversion.
 pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     check_output(options)?;
     if options.samples == 0 {
         return Err(Error::Usage("--samples must be at least 1".into()));
     }
+    let joint_samples = match options.joint_samples {
+        Some(0) => return Err(Error::Usage("--joint-samples must be at least 1".into())),
+        Some(n) => n,
+        None if options.estimate_gloss => fitting::gloss::SEARCH_SAMPLES,
+        None => joint::DEFAULT_JOINT_SAMPLES,
+    };
     if options.estimate_gloss && options.method == Method::Paper {
         return Err(Error::Usage(
             "--gloss auto fits the gloss with the joint fit: it cannot be combined with --method paper"
@@ -433,6 +472,8 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             &observations,
             &GlossSearch {
                 final_repeats: options.repeats,
+                final_samples: joint_samples,
+                progress: options.progress,
                 ..GlossSearch::starting_from(fit_options)
             },
         )?;
@@ -476,6 +517,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
                 &f.lights,
                 &JointOptions {
                     repeats: options.repeats,
+                    samples: joint_samples,
                     progress: options.progress,
                     ..JointOptions::new(fit_options.model, options.seed)
                 },
@@ -561,6 +603,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         .enumerate()
         .map(|(i, l)| light_report(&scene, l, uncertainties.get(i), light_name(i)))
         .collect();
+    warnings.extend(shared_streak_warnings(&light_reports));
     {
         let to_write: Vec<LightToWrite> = lights
             .iter()
@@ -609,6 +652,10 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             repeats: match options.method {
                 Method::Joint => options.repeats,
                 Method::Paper => 1,
+            },
+            joint_samples: match (options.method, options.estimate_gloss) {
+                (Method::Paper, false) => None,
+                _ => Some(joint::effective_samples(joint_samples)),
             },
             exposure: options.exposure,
             nits_scale: options.load.nits_scale,

@@ -54,6 +54,9 @@ pub struct Settings {
     pub seed: u64,
     /// Independent joint fits averaged (1 for the paper method).
     pub repeats: u32,
+    /// Lobe samples per pixel of the (final) joint fit, as taken (`None` for the paper
+    /// method).
+    pub joint_samples: Option<u32>,
     /// Divisor applied to the photo's linear values.
     pub exposure: f32,
     /// Intensity units per unit of radiance in the written lights.

@@ -157,12 +157,14 @@ fn good_input_fits_a_light_and_validates() {
         &photo,
         &glb,
         &report,
-        &["--repeats", "2"],
+        &["--repeats", "2", "--joint-samples", "33"],
     ));
     assert!(ok, "{stderr}");
     assert!(stderr.contains("joint fit: repeat 2 of 2"), "{stderr}");
     let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     assert_eq!(r["settings"]["repeats"], 2);
+    // 33 asked, rounded to two halves of 2 x 2 camera rays times 2 x 2 lobe samples.
+    assert_eq!(r["settings"]["joint_samples"], 32);
     gltf_check::assert_validator_clean(&glb);
 }
 
@@ -191,6 +193,13 @@ fn photo_problems_are_refused() {
         &close,
         &["--repeats", "0"],
         &["--repeats", "0 is not in 1.."],
+    );
+    expect_refusal(
+        &dir,
+        &scene,
+        &close,
+        &["--joint-samples", "0"],
+        &["--joint-samples", "0 is not in 1.."],
     );
     // Missing.
     expect_refusal(

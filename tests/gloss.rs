@@ -198,9 +198,11 @@ fn gloss_auto_through_the_converter() {
     let dir = std::env::temp_dir().join(format!("streaklight-gloss-auto-{}", std::process::id()));
     samples::write_scenes(&dir).expect("sample scenes");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    static LINES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
     let options = ConvertOptions {
         exposure: samples::PHOTO_EXPOSURE,
         estimate_gloss: true,
+        progress: Some(|line| LINES.lock().unwrap().push(line.to_string())),
         ..ConvertOptions::new(
             dir.join("scene.gltf"),
             root.join("samples/gloss1000.png"),
@@ -236,6 +238,26 @@ fn gloss_auto_through_the_converter() {
         report.settings.gloss
     );
     assert!(report.settings.gloss_source.contains("estimated"));
+    // The search told each of its fits, and the final one, as they started.
+    let lines = LINES.lock().unwrap().clone();
+    let searched = lines
+        .iter()
+        .filter(|l| l.starts_with("gloss search: joint fit "))
+        .count();
+    assert!(searched >= 3, "{lines:?}");
+    assert!(
+        lines.iter().any(|l| l
+            == &format!(
+                "gloss search: final joint fit at e = {:.0}",
+                report.settings.gloss
+            )),
+        "{lines:?}"
+    );
+    // The final fit's samples, not the joint fit's own default.
+    assert_eq!(
+        report.settings.joint_samples,
+        Some(streaklight::fitting::gloss::SEARCH_SAMPLES)
+    );
     assert_eq!(report.lights.len(), 1);
     let light = &report.lights[0];
     let truth = samples::table1_light();

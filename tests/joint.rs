@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use streaklight::convert::{convert, ConvertOptions, Method};
-use streaklight::report::LightReport;
+use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
 
 /// Per edge (left, right, bottom, top), the error as a fraction of the light's size along
@@ -37,6 +37,11 @@ fn fit(photo: &str, method: Method) -> Vec<LightReport> {
 
 /// [`fit`] with `repeats` independent joint fits averaged.
 fn fit_repeated(photo: &str, method: Method, repeats: u32) -> Vec<LightReport> {
+    fit_report(photo, method, repeats).lights
+}
+
+/// The whole report of [`fit_repeated`].
+fn fit_report(photo: &str, method: Method, repeats: u32) -> Report {
     let dir = scenes();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let tag = format!("{}-{}-{repeats}", photo.replace('.', "_"), method.name());
@@ -50,8 +55,8 @@ fn fit_repeated(photo: &str, method: Method, repeats: u32) -> Vec<LightReport> {
             dir.join(format!("{tag}.gltf")),
         )
     };
-    let lights = convert(&options).expect("fit").report.lights;
-    for l in &lights {
+    let report = convert(&options).expect("fit").report;
+    for l in &report.lights {
         eprintln!(
             "{photo} {}: corner {:?} {:.4} x {:.4} L {:?}",
             method.name(),
@@ -61,7 +66,7 @@ fn fit_repeated(photo: &str, method: Method, repeats: u32) -> Vec<LightReport> {
             l.radiance
         );
     }
-    lights
+    report
 }
 
 /// How many standard deviations (the report's uncertainties) each edge and the radiance
@@ -145,7 +150,14 @@ fn joint_fits_table1() {
 #[test]
 fn joint_fits_table3() {
     let truths = samples::table3_lights();
-    let joint = fit("table3.png", Method::Joint);
+    let report = fit_report("table3.png", Method::Joint, 1);
+    // Two streaks, one light each: nothing to warn about overlapping reflections.
+    assert!(
+        report.warnings.iter().all(|w| !w.contains("overlap")),
+        "{:?}",
+        report.warnings
+    );
+    let joint = report.lights;
     assert_eq!(joint.len(), 2);
     let (e0, r0) = errors(&joint[0], &truths[0]);
     let (e1, r1) = errors(&joint[1], &truths[1]);
@@ -210,9 +222,22 @@ fn joint_fits_table3() {
 #[test]
 fn joint_splits_overlapping_streaks() {
     let truths = samples::stacked_lights();
-    let paper = fit("stacked.png", Method::Paper);
-    assert_eq!(paper.len(), 1, "the paper method sees one light");
-    let mut joint = fit("stacked.png", Method::Joint);
+    let paper = fit_report("stacked.png", Method::Paper, 1);
+    assert_eq!(paper.lights.len(), 1, "the paper method sees one light");
+    assert_eq!(paper.settings.joint_samples, None, "no joint fit ran");
+    let report = fit_report("stacked.png", Method::Joint, 1);
+    // The user is told that the two lights of one streak are weakly told apart.
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("streak 0 holds 2 lights")
+                && w.contains("streaklight_light_0, streaklight_light_1")
+                && w.contains("reported uncertainties")),
+        "{:?}",
+        report.warnings
+    );
+    let mut joint = report.lights;
     assert_eq!(joint.len(), 2, "the joint fit splits the merged streak");
     joint.sort_by(|a, b| a.corner_left_bottom[1].total_cmp(&b.corner_left_bottom[1]));
     for (light, truth) in joint.iter().zip(&truths) {
@@ -291,6 +316,10 @@ fn joint_method_through_the_converter() {
     };
     let outcome = convert(&options).expect("joint fit");
     assert_eq!(outcome.report.settings.method, "joint");
+    assert_eq!(
+        outcome.report.settings.joint_samples,
+        Some(streaklight::fitting::joint::DEFAULT_JOINT_SAMPLES)
+    );
     assert_eq!(outcome.report.lights.len(), 1);
     let light = &outcome.report.lights[0];
     let truth = samples::table1_light();

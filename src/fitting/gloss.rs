@@ -121,6 +121,9 @@ pub struct GlossSearch {
     /// Independent final fits at the estimate whose mean is the result
     /// ([`JointOptions::repeats`]).
     pub final_repeats: u32,
+    /// Told a line as each joint fit of the search, and the final fit (and its repeats),
+    /// starts (None: silent): the search takes tens of seconds.
+    pub progress: Option<fn(&str)>,
 }
 
 /// Joint-fit samples per pixel of the search and of the final fit (module doc: the cost is
@@ -148,6 +151,7 @@ impl GlossSearch {
             search_sweeps: 6,
             final_samples: SEARCH_SAMPLES,
             final_repeats: 1,
+            progress: None,
         }
     }
 
@@ -335,6 +339,9 @@ pub fn estimate_gloss(
     }
 
     // The lights at the estimate, fitted in full from the same start.
+    if let Some(say) = options.progress {
+        say(&format!("gloss search: final joint fit at e = {gloss:.0}"));
+    }
     let t = Instant::now();
     let final_fit = fit_joint(
         scene,
@@ -345,6 +352,7 @@ pub fn estimate_gloss(
         &JointOptions {
             samples: options.final_samples,
             repeats: options.final_repeats,
+            progress: options.progress,
             ..JointOptions::new(model_at(options, gloss), options.fit.seed)
         },
     )?;
@@ -418,6 +426,13 @@ impl Cost<'_> {
     /// The cost at `x = ln e` as a point of the curve.
     fn point(&mut self, x: f64) -> Result<Point> {
         let gloss = x.exp() as f32;
+        if let Some(say) = self.options.progress {
+            say(&format!(
+                "gloss search: joint fit {} of at most {}, at e = {gloss:.0}",
+                self.evaluations.len() + 1,
+                self.options.max_evaluations
+            ));
+        }
         let fit = fit_joint(
             self.scene,
             self.photo,

@@ -113,6 +113,13 @@ impl JointOptions {
 /// Default lobe samples per pixel of the joint fit.
 pub const DEFAULT_JOINT_SAMPLES: u32 = 72;
 
+/// The samples per pixel a joint fit asked for `samples` actually takes: the count is
+/// rounded to two halves of `CAMERA_STRATA^2` camera rays times a square number of lobe
+/// samples (8, 32, 72, 128, 200, 288, ...).
+pub fn effective_samples(samples: u32) -> u32 {
+    2 * CAMERA_STRATA * CAMERA_STRATA * lobe_strata(samples).pow(2)
+}
+
 /// One-sigma uncertainties of a light's parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Uncertainty {
@@ -409,7 +416,7 @@ fn trace_samples(
 ) -> (Vec<PlaneSamples>, u32) {
     type Hits = Vec<(u16, Vec2, Vec2, f32)>;
     let lobe = lobe_strata(samples);
-    let per_pixel_samples = 2 * CAMERA_STRATA * CAMERA_STRATA * lobe * lobe;
+    let per_pixel_samples = effective_samples(samples);
     let per_pixel: Vec<Hits> = pixels
         .par_iter()
         .map(|&pixel| {
