@@ -7,7 +7,10 @@
 //! `cargo bench --bench spread` runs 8 seeds of Table 3 and the stacked sample with 1 and 4
 //! repeats (about 8 minutes on 2 cores). Environment: `SPREAD_SEEDS` (count), `SPREAD_REPEATS`
 //! (comma-separated, e.g. "1,4"), `SPREAD_CASES` (comma-separated photo names, e.g.
-//! "table1.png,table3.png,stacked.png").
+//! "table1.png,table3.png,stacked.png"), `SPREAD_JOINT_SAMPLES` (`--joint-samples`; unset: the
+//! default), `SPREAD_RENDER_SPP` (fit a fresh render of each case's truth scene with this many
+//! camera rays per pixel instead of the committed 256-spp photo: a photo with less of its own
+//! noise).
 
 use std::path::{Path, PathBuf};
 
@@ -80,21 +83,37 @@ fn main() {
         .map(|s| s.parse().expect("SPREAD_REPEATS: counts such as 1,4"))
         .collect();
     let cases = env_list("SPREAD_CASES", "table3.png,stacked.png");
+    let render_spp: Option<u32> = std::env::var("SPREAD_RENDER_SPP")
+        .ok()
+        .map(|s| s.parse().expect("SPREAD_RENDER_SPP: a count such as 4096"));
+    let joint_samples: Option<u32> = std::env::var("SPREAD_JOINT_SAMPLES").ok().map(|s| {
+        s.parse()
+            .expect("SPREAD_JOINT_SAMPLES: a count such as 288")
+    });
     let dir = std::env::temp_dir().join(format!("streaklight-spread-{}", std::process::id()));
     samples::write_scenes(&dir).expect("writing the sample scenes");
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    println!("seeds 1..={seeds}; errors in % of the size (edges) and of the radiance");
+    println!(
+        "seeds 1..={seeds}; joint samples {}; photos {}; errors in % of the size (edges) and of \
+         the radiance",
+        joint_samples.map_or("default".into(), |n| n.to_string()),
+        render_spp.map_or("committed".into(), |n| format!("rendered at {n} spp"))
+    );
     println!();
     println!("| photo | repeats | light | rms error L, R, B, T; rad | mean error | rms sigmas | largest sigma | s per fit |");
     println!("|---|---|---|---|---|---|---|---|");
     for photo in &cases {
         let truth = truths(photo);
+        let photo_path = match render_spp {
+            None => root.join("samples").join(photo),
+            Some(spp) => rendered(&dir, photo, spp),
+        };
         for &r in &repeats {
             let mut per_light: Vec<Vec<Measure>> = vec![Vec::new(); truth.len()];
             let mut seconds = 0.0;
             for seed in 1..=seeds {
                 let t = std::time::Instant::now();
-                let lights = fit(&dir, &root.join("samples").join(photo), seed, r);
+                let lights = fit(&dir, &photo_path, seed, r, joint_samples);
                 seconds += t.elapsed().as_secs_f64();
                 for (k, t) in truth.iter().enumerate() {
                     // The fitted light nearest the truth's centre.
@@ -137,19 +156,46 @@ fn main() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The sample photo `photo` rendered afresh from its truth scene with `spp` camera rays per
+/// pixel, written into `dir`.
+fn rendered(dir: &Path, photo: &str, spp: u32) -> PathBuf {
+    let spec = samples::catalogue()
+        .into_iter()
+        .find(|s| s.photo.as_deref() == Some(photo))
+        .unwrap_or_else(|| panic!("{photo} is not a sample photo"));
+    let t = std::time::Instant::now();
+    let image = samples::render_photo(dir, &spec, spp, false).expect("rendering the photo");
+    let path = dir.join(format!("rendered-{spp}-{photo}"));
+    streaklight::photo_out::write(&path, image.width, image.height, &image.pixels)
+        .expect("writing the photo");
+    eprintln!(
+        "rendered {photo} at {spp} spp in {:.0} s",
+        t.elapsed().as_secs_f64()
+    );
+    path
+}
+
 fn distance(light: &LightReport, truth: &SampleLight) -> f64 {
     let c = light.corner_left_bottom;
     let centre = truth.center();
     (c[0] + light.width / 2.0 - centre.x).hypot(c[1] + light.height / 2.0 - centre.y)
 }
 
-/// `streaklight fit` of `photo` with `seed` and `repeats`: the report's lights.
-fn fit(dir: &Path, photo: &Path, seed: u64, repeats: u32) -> Vec<LightReport> {
+/// `streaklight fit` of `photo` with `seed`, `repeats` and `--joint-samples`: the report's
+/// lights.
+fn fit(
+    dir: &Path,
+    photo: &Path,
+    seed: u64,
+    repeats: u32,
+    joint_samples: Option<u32>,
+) -> Vec<LightReport> {
     let options = ConvertOptions {
         exposure: samples::PHOTO_EXPOSURE,
         method: Method::Joint,
         seed,
         repeats,
+        joint_samples,
         ..ConvertOptions::new(
             dir.join("scene.gltf"),
             photo,

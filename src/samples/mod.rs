@@ -430,23 +430,34 @@ pub fn write_scenes(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(written)
 }
 
+/// Renders the photo of the sample scene `spec` (written in `dir` already) as `samples` does,
+/// with `spp` camera rays per pixel.
+pub fn render_photo(
+    dir: &Path,
+    spec: &SampleScene,
+    spp: u32,
+    progress: bool,
+) -> Result<crate::render::Rendered> {
+    let scene = crate::scene_in::load(&dir.join(&spec.file), &Default::default())?;
+    let options = crate::render::RenderOptions {
+        width: PHOTO_SIZE,
+        height: PHOTO_SIZE,
+        samples_per_pixel: spp,
+        exposure: PHOTO_EXPOSURE,
+        seed: 1,
+        progress,
+        ..Default::default()
+    };
+    crate::render::render(&scene, &options)
+}
+
 /// Renders the photo of every sample scene that has one (the scenes must be written
 /// already), with `spp` camera rays per pixel; returns the files written.
 pub fn render_photos(dir: &Path, spp: u32, progress: bool) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     for spec in catalogue() {
         let Some(photo) = &spec.photo else { continue };
-        let scene = crate::scene_in::load(&dir.join(&spec.file), &Default::default())?;
-        let options = crate::render::RenderOptions {
-            width: PHOTO_SIZE,
-            height: PHOTO_SIZE,
-            samples_per_pixel: spp,
-            exposure: PHOTO_EXPOSURE,
-            seed: 1,
-            progress,
-            ..Default::default()
-        };
-        let image = crate::render::render(&scene, &options)?;
+        let image = render_photo(dir, &spec, spp, progress)?;
         let path = dir.join(photo);
         crate::photo_out::write(&path, image.width, image.height, &image.pixels)?;
         written.push(path);
