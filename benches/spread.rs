@@ -10,7 +10,8 @@
 //! "table1.png,table3.png,stacked.png"), `SPREAD_JOINT_SAMPLES` (`--joint-samples`; unset: the
 //! default), `SPREAD_RENDER_SPP` (fit a fresh render of each case's truth scene with this many
 //! camera rays per pixel instead of the committed 256-spp photo: a photo with less of its own
-//! noise).
+//! noise), `SPREAD_RENDER_CACHE` (a directory: such renders are kept there and reused by later
+//! runs, which saves minutes per case; empty it after changing the renderer).
 
 use std::path::{Path, PathBuf};
 
@@ -90,6 +91,7 @@ fn main() {
         s.parse()
             .expect("SPREAD_JOINT_SAMPLES: a count such as 288")
     });
+    let cache = std::env::var_os("SPREAD_RENDER_CACHE").map(PathBuf::from);
     let dir = std::env::temp_dir().join(format!("streaklight-spread-{}", std::process::id()));
     samples::write_scenes(&dir).expect("writing the sample scenes");
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
@@ -106,7 +108,7 @@ fn main() {
         let truth = truths(photo);
         let photo_path = match render_spp {
             None => root.join("samples").join(photo),
-            Some(spp) => rendered(&dir, photo, spp),
+            Some(spp) => rendered(&dir, photo, spp, cache.as_deref()),
         };
         for &r in &repeats {
             let mut per_light: Vec<Vec<Measure>> = vec![Vec::new(); truth.len()];
@@ -157,15 +159,23 @@ fn main() {
 }
 
 /// The sample photo `photo` rendered afresh from its truth scene with `spp` camera rays per
-/// pixel, written into `dir`.
-fn rendered(dir: &Path, photo: &str, spp: u32) -> PathBuf {
+/// pixel, written into `dir`, or into `cache` if given (where an earlier run's render is
+/// reused).
+fn rendered(dir: &Path, photo: &str, spp: u32, cache: Option<&Path>) -> PathBuf {
+    let path = cache.unwrap_or(dir).join(format!("rendered-{spp}-{photo}"));
+    if cache.is_some() && path.is_file() {
+        eprintln!("reusing {}", path.display());
+        return path;
+    }
     let spec = samples::catalogue()
         .into_iter()
         .find(|s| s.photo.as_deref() == Some(photo))
         .unwrap_or_else(|| panic!("{photo} is not a sample photo"));
     let t = std::time::Instant::now();
     let image = samples::render_photo(dir, &spec, spp, false).expect("rendering the photo");
-    let path = dir.join(format!("rendered-{spp}-{photo}"));
+    if let Some(cache) = cache {
+        std::fs::create_dir_all(cache).expect("creating SPREAD_RENDER_CACHE");
+    }
     streaklight::photo_out::write(&path, image.width, image.height, &image.pixels)
         .expect("writing the photo");
     eprintln!(

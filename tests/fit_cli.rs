@@ -47,6 +47,13 @@ fn run(args: &[String]) -> (bool, String) {
     (ok, stderr)
 }
 
+/// Runs `fit --allow-empty` and asserts success; returns its stderr.
+fn fit_allowing_empty(scene: &Path, photo: &Path, out: &Path, report: &Path) -> String {
+    let (ok, stderr) = run(&fit_args(scene, photo, out, report, &["--allow-empty"]));
+    assert!(ok, "{stderr}");
+    stderr
+}
+
 /// Runs `fit` on `scene` and `photo` into `dir/out.gltf` (report `dir/report.json`) and asserts
 /// a failure whose message holds every one of `words`, with nothing written into `dir` (its
 /// listing is unchanged).
@@ -268,14 +275,7 @@ fn photos_without_streaks_are_refused_unless_allowed() {
     // --allow-empty: success, and the scene written with nothing lost (and validator-clean).
     let out = dir.join("empty-out.gltf");
     let report = dir.join("empty-report.json");
-    let (ok, stderr) = run(&fit_args(
-        &scene,
-        &dir.join("black.png"),
-        &out,
-        &report,
-        &["--allow-empty"],
-    ));
-    assert!(ok, "{stderr}");
+    let stderr = fit_allowing_empty(&scene, &dir.join("black.png"), &out, &report);
     assert!(stderr.to_lowercase().contains("streak"), "{stderr}");
     gltf_check::assert_keeps_everything(&scene, &out);
     let (a, b) = (gltf_check::load(&scene), gltf_check::load(&out));
@@ -297,14 +297,7 @@ fn nothing_for_the_light_to_hang_on() {
     assert!(msg.contains("geometry"), "{msg}");
     // Allowed empty: written unchanged, with the reason as a warning.
     let out = dir.join("allowed.gltf");
-    let (ok, stderr) = run(&fit_args(
-        &scene,
-        &photo,
-        &out,
-        &dir.join("allowed.json"),
-        &["--allow-empty"],
-    ));
-    assert!(ok, "{stderr}");
+    let stderr = fit_allowing_empty(&scene, &photo, &out, &dir.join("allowed.json"));
     assert!(stderr.contains("geometry"), "{stderr}");
     assert_eq!(gltf_check::load(&scene).json, gltf_check::load(&out).json);
     gltf_check::assert_validator_clean(&out);

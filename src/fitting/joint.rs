@@ -1687,16 +1687,18 @@ impl Problem {
     fn descend(&self, st: &mut State, extents: &[Option<Rect>], sweeps: u32) {
         // Initial half-windows: see `first_window`.
         let windows = st.rects.iter().map(|r| [first_window(r); 4]).collect();
-        self.descend_from(st, extents, sweeps, windows);
+        self.descend_from(st, extents, sweeps, windows, GRID);
     }
 
-    /// [`Problem::descend`] with the given initial half-windows per light and edge.
+    /// [`Problem::descend`] with the given initial half-windows per light and edge, and `grid`
+    /// points per edge search.
     fn descend_from(
         &self,
         st: &mut State,
         extents: &[Option<Rect>],
         sweeps: u32,
         mut windows: Vec<[f32; 4]>,
+        grid: usize,
     ) {
         for _sweep in 0..sweeps {
             for k in 0..st.rects.len() {
@@ -1717,9 +1719,9 @@ impl Problem {
                         windows[k][side as usize] = MIN_WINDOW;
                         continue;
                     }
-                    let step = (b - a) / (GRID - 1) as f32;
-                    let prof = self.edge_profile(st, k, side, a, step, GRID);
-                    let cur_j = ((cur - a) / step).round().clamp(0.0, (GRID - 1) as f32) as usize;
+                    let step = (b - a) / (grid - 1) as f32;
+                    let prof = self.edge_profile(st, k, side, a, step, grid);
+                    let cur_j = ((cur - a) / step).round().clamp(0.0, (grid - 1) as f32) as usize;
                     // Prefer the current position on ties (flat cost: an unconstrained edge).
                     let mut best = cur_j;
                     for (j, p) in prof.iter().enumerate() {
@@ -1897,10 +1899,22 @@ impl Problem {
 }
 
 /// Sweeps of each half's refit in [`sample_spread`]: they start at the optimum with windows
-/// of a tenth of the light's size. Over 8 seeds of Table 3 (started from the truth), light0's
-/// errors came out 0.8-1.2 sigma rms with 2, 3, 4 and 10 sweeps alike; 2 take 0.2 s less
-/// than 4.
-const SPREAD_SWEEPS: u32 = 2;
+/// of a tenth of the light's size. Two were enough for Table 3's light0 (its errors 0.8-1.2
+/// sigma rms over 8 seeds with 2, 3, 4 and 10 sweeps alike), but not for light1, whose height
+/// trades against its radiance and whose refits travel that valley slowly: through the
+/// pipeline on a 4096-spp render of Table 3, seeds 1-8, light1's bottom / top / radiance
+/// errors came out 2.8 / 4.7 / 3.9 sigma rms with 2 sweeps, 3.0 / 4.8 / 4.2 with 3,
+/// 3.6 / 2.1 / 2.7 with 4, 3.1 / 1.6 / 2.2 with 5, 2.7 / 1.5 / 2.1 with 10 and 20
+/// (BENCHMARKS.md, seventh session).
+const SPREAD_SWEEPS: u32 = 5;
+
+/// Grid points per edge in [`sample_spread`]'s refits, against [`GRID`] in the fit: their
+/// windows start at a tenth of the light's size, not half, so 17 points are as fine as the
+/// fit's 65 were in its first sweep, and the refits' extra sweeps cost less (the Table 3
+/// benchmark's joint optimisation: 1.53 s with 2 sweeps at 65 points, 1.94 s with 5 at 65,
+/// 1.74 s with 5 at 17). The sigmas above were measured at 65 points; at 17, with 5 sweeps,
+/// light1's came out 1.8 / 1.0 / 1.6 rms and light0's 1.0-1.7.
+const SPREAD_GRID: usize = 17;
 
 /// How far the fit's own samples move its result: the fit repeated from each independent half
 /// of the samples alone, starting at the optimum, and half the two refits' difference taken
@@ -1942,7 +1956,7 @@ fn sample_spread(
                 .iter()
                 .map(|r| [(0.1 * r.width().max(r.height())).max(0.05); 4])
                 .collect();
-            half.descend_from(&mut refit, extents, SPREAD_SWEEPS, windows);
+            half.descend_from(&mut refit, extents, SPREAD_SWEEPS, windows, SPREAD_GRID);
             refit
         })
         .collect();
