@@ -387,8 +387,8 @@ fn shared_streak_warnings(lights: &[LightReport]) -> Vec<String> {
             format!(
                 "streak {streak} holds {} lights ({}), whose reflections overlap: the photo tells them \
                  apart only weakly where they meet, so their facing edges and radiances may be off \
-                 by several percent (up to 20 % on the bundled stacked sample), several times \
-                 their reported uncertainties",
+                 by several percent (up to 20 % on the bundled stacked sample); their reported \
+                 uncertainties are correspondingly wide",
                 names.len(),
                 names.join(", ")
             )

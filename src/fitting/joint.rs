@@ -1996,9 +1996,10 @@ fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect) -> (f32, f32) {
 /// does not constrain it), and so does a pinned one.
 fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec<Uncertainty> {
     let lights = st.rects.len();
-    // Parameters: per light its free edges, then its three radiances.
+    // Parameters: per light its free edges (with the coefficients' derivative and the
+    // derivative of their half-difference), then its three radiances.
     enum Param {
-        Edge(usize, EdgeSide, Vec<f32>),
+        Edge(usize, EdgeSide, Vec<f32>, Vec<f32>),
         Radiance(usize, usize),
     }
     let mut params: Vec<Param> = Vec::new();
@@ -2011,15 +2012,14 @@ fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec
             }
             let e = r.edge(side);
             let set = st.set_of[k];
-            let (plus, _) = problem.coefficients(set, &r.with_edge(side, e + h));
-            let (minus, _) = problem.coefficients(set, &r.with_edge(side, e - h));
-            let g: Vec<f32> = plus
-                .iter()
-                .zip(&minus)
-                .map(|(p, m)| (p - m) / (2.0 * h))
-                .collect();
+            let (plus, plus_dev) = problem.coefficients(set, &r.with_edge(side, e + h));
+            let (minus, minus_dev) = problem.coefficients(set, &r.with_edge(side, e - h));
+            let slope = |p: &[f32], m: &[f32]| -> Vec<f32> {
+                p.iter().zip(m).map(|(p, m)| (p - m) / (2.0 * h)).collect()
+            };
+            let g = slope(&plus, &minus);
             if g.iter().any(|&x| x != 0.0) {
-                params.push(Param::Edge(k, side, g));
+                params.push(Param::Edge(k, side, g, slope(&plus_dev, &minus_dev)));
             }
         }
         for ch in 0..3 {
@@ -2027,23 +2027,34 @@ fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec
         }
     }
     let p = params.len();
-    // d model[i][ch] / d param, for one pixel and channel.
-    let derivative = |param: &Param, i: usize, ch: usize| -> f64 {
+    // d model[i][ch] / d param and d (half-difference)[i][ch] / d param.
+    let derivative = |param: &Param, i: usize, ch: usize| -> (f64, f64) {
         match param {
-            Param::Edge(k, _, g) => st.radiance[*k][ch] * g[i] as f64,
-            Param::Radiance(k, c) if *c == ch => st.coef[*k][i] as f64,
-            Param::Radiance(..) => 0.0,
+            Param::Edge(k, _, g, gd) => (
+                st.radiance[*k][ch] * g[i] as f64,
+                st.radiance[*k][ch] * gd[i] as f64,
+            ),
+            Param::Radiance(k, c) if *c == ch => (st.coef[*k][i] as f64, st.dev[*k][i] as f64),
+            Param::Radiance(..) => (0.0, 0.0),
         }
     };
-    // Sandwich (cluster-robust) covariance: bread^-1 meat bread^-1 with bread = J^T J and
-    // meat = sum over pixels of s s^T, s = sum over channels of r J. The noise is far from
-    // uniform (a streak's bright pixels carry most of it, the dark surroundings none), the
-    // three channels of a pixel share it (a white light), and the stored samples add their
-    // own: a single variance sigma^2 for all would understate the errors tenfold (measured
-    // on Table 1), the residuals themselves carry all three.
+    // Sandwich (cluster-robust) covariance: bread^-1 meat bread^-1, with the bread and the
+    // scores those of the cost the fit minimises, sum of r^2 - d^2 (see the note on the
+    // coefficients' noise): bread = sum of (J J^T - Jd Jd^T), score per pixel = sum over
+    // channels of (r J + d Jd). The plain J^T J counts the samples' noise in the derivatives
+    // as curvature (E[J_est J_est^T] = J J^T + their variance), so along a direction the photo
+    // barely constrains (Table 3's light1: its height against its radiance) it claimed
+    // several times the real curvature and the sigmas came out small (BENCHMARKS.md,
+    // seventh session). The noise is far from uniform (a streak's bright pixels carry most
+    // of it, the dark surroundings none), the three channels of a pixel share it (a white
+    // light), and the stored samples add their own: a single variance sigma^2 for all would
+    // understate the errors tenfold (measured on Table 1), the residuals themselves carry
+    // all three.
     let mut jtj = vec![0.0; p * p];
+    let mut raw_diagonal = vec![0.0; p];
     let mut meat = vec![0.0; p * p];
     let mut row = vec![0.0; p];
+    let mut dev_row = vec![0.0; p];
     let mut score = vec![0.0; p];
     for i in (0..problem.n()).filter(|&i| !problem.clipped[i]) {
         let m = problem.model(st, i);
@@ -2051,15 +2062,19 @@ fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec
         let mut any = false;
         for (ch, (obs, model)) in problem.obs[i].iter().zip(m).enumerate() {
             let r = *obs as f64 - model;
+            let d: f64 = (0..lights)
+                .map(|k| st.radiance[k][ch] * st.dev[k][i] as f64)
+                .sum();
             for (a, param) in params.iter().enumerate() {
-                row[a] = derivative(param, i, ch);
-                score[a] += r * row[a];
+                (row[a], dev_row[a]) = derivative(param, i, ch);
+                score[a] += r * row[a] + d * dev_row[a];
                 any |= row[a] != 0.0;
             }
             for a in 0..p {
-                if row[a] != 0.0 {
+                if row[a] != 0.0 || dev_row[a] != 0.0 {
+                    raw_diagonal[a] += row[a] * row[a];
                     for b in 0..p {
-                        jtj[a * p + b] += row[a] * row[b];
+                        jtj[a * p + b] += row[a] * row[b] - dev_row[a] * dev_row[b];
                     }
                 }
             }
@@ -2073,6 +2088,11 @@ fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec
                 }
             }
         }
+    }
+    // As in the fit (`solve_radiance`, the edge profiles): never trust less than half the
+    // raw curvature of a parameter.
+    for a in 0..p {
+        jtj[a * p + a] = jtj[a * p + a].max(0.5 * raw_diagonal[a]);
     }
     // A radiance channel nothing depends on (a light with no sample) stays solvable.
     for a in 0..p {
@@ -2110,7 +2130,7 @@ fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec
                 f32::INFINITY
             };
             match param {
-                Param::Edge(k, side, _) => out[*k].edges[*side as usize] = Some(sd),
+                Param::Edge(k, side, ..) => out[*k].edges[*side as usize] = Some(sd),
                 Param::Radiance(k, ch) => out[*k].radiance[*ch] = sd,
             }
         }
