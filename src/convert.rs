@@ -84,8 +84,8 @@ pub struct ConvertOptions {
     /// the scene's or `load.gloss` is the search's start). Implies the joint fit.
     pub estimate_gloss: bool,
     /// Independent joint fits, each from its own samples, whose mean is the result (at least
-    /// 1; see [`JointOptions::repeats`]): N times slower, with uncertainties that hold where
-    /// one fit's understate them (a light seen only through an overlap or a cut streak).
+    /// 1; see [`JointOptions::repeats`]): N times slower, about sqrt(N) times less of the
+    /// samples' noise, with the fits' spread added to the uncertainties.
     pub repeats: u32,
     /// Lobe samples per pixel of the joint fit (`None`: its default,
     /// [`joint::DEFAULT_JOINT_SAMPLES`], or under `--gloss auto` the final fit's
@@ -370,9 +370,10 @@ fn skipped_report(s: &Skipped) -> SkippedStreak {
 }
 
 /// One warning per streak that was fitted as several lights (overlapping reflections, split
-/// by the joint fit): the photo tells such lights apart only weakly, and their uncertainties
-/// understate it (BENCHMARKS.md, "Repeated fits": the stacked sample's lower light is off by
-/// 5-19 % in its top edge at 13-24 reported sigmas with one fit, 4-6 with four repeats).
+/// by the joint fit): the photo tells such lights apart only weakly, so their facing edges and
+/// radiances can be off by 10 % and more (the stacked sample's lower light: top edge 12 % rms
+/// over 8 seeds). Their reported uncertainties are as wide (BENCHMARKS.md, "Uncertainties: the
+/// curvature of the cost the fit minimises"); the warning says why.
 fn shared_streak_warnings(lights: &[LightReport]) -> Vec<String> {
     let mut by_streak: std::collections::BTreeMap<usize, Vec<&str>> = Default::default();
     for light in lights {

@@ -48,9 +48,8 @@ pub struct Args {
     #[arg(long, default_value = "joint", value_parser = ["joint", "paper"])]
     pub method: String,
     /// Run the joint fit this many times, each from its own samples, and report the mean: N
-    /// times slower, about sqrt(N) times less of the samples' noise, and uncertainties that
-    /// hold where one fit's understate them (lights seen only through overlapping or cut
-    /// streaks).
+    /// times slower, about sqrt(N) times less of the samples' noise; the uncertainties add the
+    /// fits' spread (and so come out on the wide side).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeats: u32,
     /// Lobe samples per pixel of the joint fit, rounded to 8 b^2 (8, 32, 72, 128, 200, 288,

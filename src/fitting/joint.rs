@@ -85,8 +85,8 @@ pub struct JointOptions {
     pub region_gloss: Option<f32>,
     /// Independent fits, each from its own samples, whose mean is the result (at least 1).
     /// From 2 on, their spread replaces the half-sample estimate of how far the samples move
-    /// the fit ([`sample_spread`]), which understates it along weakly seen directions; the
-    /// mean's own error falls as one over the square root of the count.
+    /// the fit ([`sample_spread`]); the mean's own error falls as one over the square root of
+    /// the count.
     pub repeats: u32,
     /// Told a line as each repeat starts, when there are several (None: silent).
     pub progress: Option<fn(&str)>,
@@ -1921,12 +1921,12 @@ const SPREAD_GRID: usize = 17;
 /// per parameter (edges in metres, radiance per channel). For independent halves, E[(a - b)^2]
 /// / 4 is half one half's variance, which is about the variance of the fit from both.
 ///
-/// This is the part of the error the curvature misses. The samples are common to every
-/// rectangle the fit tries, so their noise shapes the cost itself, and along a weakly seen
-/// direction (a light's height against its radiance when the photo's border cuts its streak,
-/// or the inner edges of two stacked lights) the optimum follows it: on Table 3, refits with
-/// other seeds scatter the edges five times wider than the curvature alone says
-/// (BENCHMARKS.md). A half alone cannot remove its coefficients' noise (that takes both), so
+/// The samples are common to every rectangle the fit tries, so their noise shapes the cost
+/// itself, and along a weakly seen direction (a light's height against its radiance when the
+/// photo's border cuts its streak) the optimum follows it. Since the curvature is taken from
+/// the noise-corrected cost (see `uncertainties`) it carries most of this too; the refits
+/// still widen light0's sigmas on Table 3 from 1.2-1.6 to a better-calibrated 0.9-1.5 rms
+/// (BENCHMARKS.md, seventh session). A half alone cannot remove its coefficients' noise (that takes both), so
 /// each refit carries the same bias; the difference cancels it.
 fn sample_spread(
     problem: &Problem,
