@@ -369,8 +369,9 @@ fn skipped_report(s: &Skipped) -> SkippedStreak {
     }
 }
 
-/// One warning per streak that was fitted as several lights (overlapping reflections, split
-/// by the joint fit): the photo tells such lights apart only weakly, so their facing edges and
+/// One warning per set of lights that share streaks (overlapping reflections, split by the
+/// joint fit; a light merged from two streaks and then split makes one warning naming both
+/// streaks): the photo tells such lights apart only weakly, so their facing edges and
 /// radiances can be off by 10 % and more (the stacked sample's lower light: top edge 12 % rms
 /// over 8 seeds). Their reported uncertainties are as wide (BENCHMARKS.md, "Uncertainties: the
 /// curvature of the cost the fit minimises"); the warning says why.
@@ -381,15 +382,28 @@ fn shared_streak_warnings(lights: &[LightReport]) -> Vec<String> {
             by_streak.entry(streak).or_default().push(&light.name);
         }
     }
-    by_streak
+    // Two streaks that one merged light spans make one warning, not one per streak.
+    let mut by_lights: std::collections::BTreeMap<Vec<&str>, Vec<usize>> = Default::default();
+    for (streak, names) in by_streak {
+        if names.len() > 1 {
+            by_lights.entry(names).or_default().push(streak);
+        }
+    }
+    by_lights
         .into_iter()
-        .filter(|(_, names)| names.len() > 1)
-        .map(|(streak, names)| {
+        .map(|(names, streaks)| {
+            let ids: Vec<String> = streaks.iter().map(|s| s.to_string()).collect();
+            let (noun, verb) = if streaks.len() == 1 {
+                ("streak", "holds")
+            } else {
+                ("streaks", "hold")
+            };
             format!(
-                "streak {streak} holds {} lights ({}), whose reflections overlap: the photo tells them \
+                "{noun} {} {verb} {} lights ({}), whose reflections overlap: the photo tells them \
                  apart only weakly where they meet, so their facing edges and radiances may be off \
                  by several percent (up to 20 % on the bundled stacked sample); their reported \
                  uncertainties are correspondingly wide",
+                ids.join(", "),
                 names.len(),
                 names.join(", ")
             )

@@ -161,6 +161,8 @@ struct PlaneSamples {
     /// [`cell_half_extents`] and the note on the cells).
     cells: Vec<Vec2>,
     weights: Vec<f32>,
+    /// The smallest width and height a light on this plane may take ([`smallest_light`]).
+    min_size: Vec2,
 }
 
 impl PlaneSamples {
@@ -195,6 +197,7 @@ impl PlaneSamples {
             points: Vec::new(),
             cells: Vec::new(),
             weights: Vec::new(),
+            min_size: self.min_size,
         };
         for i in 0..self.offsets.len() - 1 {
             let r = self.range(i);
@@ -517,6 +520,7 @@ fn trace_samples(
                 points: Vec::new(),
                 cells: Vec::new(),
                 weights: Vec::new(),
+                min_size: Vec2::ZERO,
             };
             out.offsets.push(0);
             for hits in &per_pixel {
@@ -543,6 +547,7 @@ fn trace_samples(
                 out.bbox.push(bb);
                 out.offsets.push(out.points.len() as u32);
             }
+            out.min_size = smallest_light(&out.cells);
             out
         })
         .collect();
@@ -1386,6 +1391,29 @@ struct FlatSums {
     b: [f64; 3],
 }
 
+/// The smallest width and height of a light whose samples' kernels have the half-widths
+/// `cells`: twice the median half-width along each axis, the kernels' typical full width (a
+/// few millimetres when the cells are points). A narrower rectangle is seen only through the
+/// kernels' shape (its coefficient is the kernels' density where it lies, negative lobes
+/// included, from the few samples near it), so its coefficients are noise out of all
+/// proportion to their size, and the fit, which subtracts the estimated noise from its cost,
+/// rewards exactly that: two stacked lights 1.8 m apart came out as the lower light and a
+/// 1 mm sliver at 1400 times the radiance, at a cost 90 below the truth's (BENCHMARKS.md,
+/// "A sliver of light").
+fn smallest_light(cells: &[Vec2]) -> Vec2 {
+    // Every 8th sample: a median needs no more, and a plane holds millions.
+    let (mut xs, mut ys): (Vec<f32>, Vec<f32>) =
+        cells.iter().step_by(8).map(|c| (c.x, c.y)).unzip();
+    let median = |v: &mut Vec<f32>| {
+        if v.is_empty() {
+            return 0.0;
+        }
+        let mid = v.len() / 2;
+        *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
+    };
+    Vec2::new(2.0 * median(&mut xs), 2.0 * median(&mut ys)).max(Vec2::splat(2e-3))
+}
+
 /// How far the photo could possibly move an edge: the extent of light k's stored samples.
 fn sample_extent(p: &PlaneSamples) -> Option<Rect> {
     p.bbox
@@ -1712,7 +1740,8 @@ impl Problem {
                     }
                     let half = windows[k][side as usize];
                     let cur = st.rects[k].edge(side);
-                    let (lo, hi) = edge_bounds(&st.rects[k], side, &ext);
+                    let min_size = self.planes[st.set_of[k]].min_size;
+                    let (lo, hi) = edge_bounds(&st.rects[k], side, &ext, min_size);
                     let a = (cur - half).max(lo);
                     let b = (cur + half).min(hi);
                     if b <= a {
@@ -1972,14 +2001,15 @@ fn sample_spread(
         .collect()
 }
 
-/// Where an edge may go: inside the samples' extent and not past the opposite edge.
-fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect) -> (f32, f32) {
+/// Where an edge may go: inside the samples' extent (with a millimetre to spare) and no
+/// nearer the opposite edge than `min_size` ([`smallest_light`]).
+fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect, min_size: Vec2) -> (f32, f32) {
     let eps = 1e-3;
     match side {
-        EdgeSide::Left => (ext.u_min - eps, r.u_max - eps),
-        EdgeSide::Right => (r.u_min + eps, ext.u_max + eps),
-        EdgeSide::Bottom => (ext.v_min - eps, r.v_max - eps),
-        EdgeSide::Top => (r.v_min + eps, ext.v_max + eps),
+        EdgeSide::Left => (ext.u_min - eps, r.u_max - min_size.x),
+        EdgeSide::Right => (r.u_min + min_size.x, ext.u_max + eps),
+        EdgeSide::Bottom => (ext.v_min - eps, r.v_max - min_size.y),
+        EdgeSide::Top => (r.v_min + min_size.y, ext.v_max + eps),
     }
 }
 
