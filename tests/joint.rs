@@ -372,10 +372,11 @@ fn joint_method_through_the_converter() {
 /// is cut by the photo's lower border and seen mostly through its blurred end. Its height is
 /// then weakly told, but a light thinner than the samples' kernels must not win: before the
 /// fit's smallest light (`smallest_light` in src/fitting/joint.rs), the default fit of this
-/// render made the upper light 1 mm tall at 1400 times the truth's radiance (19891), because a thin light's coefficients are nearly all sample noise and the fit
-/// subtracts estimated noise from its cost. Held: every light at least 0.2 m tall (the
-/// truth's 1.0 and 1.4 m; the kernels' typical full height here is about 0.28 m) and its
-/// radiance within 4 times the truth's (14 and 16).
+/// render made the upper light 1 mm tall at 1400 times the truth's radiance (19891), because
+/// a thin light's coefficients are nearly all sample noise and the fit subtracts estimated
+/// noise from its cost. Held: every light at least 0.2 m tall (the truth's 1.0 and 1.4 m; the
+/// kernels' typical full height here is about 0.28 m) and its radiance within 4 times the
+/// truth's (14 and 16).
 #[test]
 fn stacked_lights_apart_never_become_a_sliver() {
     let dir = scenes();
@@ -392,19 +393,11 @@ fn stacked_lights_apart_never_become_a_sliver() {
     upper["translation"][1] = serde_json::json!(y + 1.0);
     let apart = dir.join("stacked-apart-truth.gltf");
     std::fs::write(&apart, doc.to_string()).expect("write the scene");
-    let scene = streaklight::scene_in::load(&apart, &Default::default()).expect("load");
-    let rendered = streaklight::render::render(
-        &scene,
-        &streaklight::render::RenderOptions {
-            width: samples::PHOTO_SIZE,
-            height: samples::PHOTO_SIZE,
-            samples_per_pixel: samples::PHOTO_SPP,
-            exposure: samples::PHOTO_EXPOSURE,
-            seed: 1,
-            ..Default::default()
-        },
-    )
-    .expect("render");
+    let spec = samples::SampleScene {
+        file: "stacked-apart-truth.gltf".into(),
+        ..samples::by_photo("stacked.png").expect("the stacked sample")
+    };
+    let rendered = samples::render_photo(&dir, &spec, samples::PHOTO_SPP, false).expect("render");
     let photo = dir.join("stacked-apart.png");
     streaklight::photo_out::write(&photo, rendered.width, rendered.height, &rendered.pixels)
         .expect("write the photo");

@@ -1399,7 +1399,9 @@ struct FlatSums {
 /// proportion to their size, and the fit, which subtracts the estimated noise from its cost,
 /// rewards exactly that: two stacked lights 1.8 m apart came out as the lower light and a
 /// 1 mm sliver at 1400 times the radiance, at a cost 90 below the truth's (BENCHMARKS.md,
-/// "A sliver of light").
+/// "A sliver of light"). A real light narrower than the bound (a strip light) comes out this
+/// wide, with the radiance that keeps its reflection; more samples per pixel make the kernels,
+/// and the bound, smaller.
 fn smallest_light(cells: &[Vec2]) -> Vec2 {
     // Every 8th sample: a median needs no more, and a plane holds millions.
     let (mut xs, mut ys): (Vec<f32>, Vec<f32>) =
