@@ -813,6 +813,26 @@ impl Problem {
             .unzip()
     }
 
+    /// Per pixel, the derivative of sample set `set`'s coefficient and of its half-difference
+    /// by one edge, as the central difference between the rectangles `plus` and `minus` (which
+    /// differ in that edge alone, by `2 h`). Only pixels with a sample in the strip between
+    /// them are computed: the others' coefficients are the same for both, their derivatives 0.
+    fn edge_slopes(&self, set: usize, plus: &Rect, minus: &Rect, h: f32) -> (Vec<f32>, Vec<f32>) {
+        let samples = &self.planes[set];
+        let strip = changed_strip(plus, minus);
+        (0..self.n())
+            .into_par_iter()
+            .map(|i| {
+                if !touches(&samples.bbox[i], strip) {
+                    return (0.0, 0.0);
+                }
+                let (p, p_dev) = samples.coefficient(i, plus, self.inv_samples, self.dev_scale);
+                let (m, m_dev) = samples.coefficient(i, minus, self.inv_samples, self.dev_scale);
+                ((p - m) / (2.0 * h), (p_dev - m_dev) / (2.0 * h))
+            })
+            .unzip()
+    }
+
     /// Moves light k to `rect`, recomputing only the coefficients of pixels with a sample
     /// where the old and the new rectangle differ (a one-edge move touches a thin strip).
     fn set_rect(&self, st: &mut State, k: usize, rect: Rect) {
@@ -826,14 +846,7 @@ impl Problem {
             .zip(st.dev[k].par_iter_mut())
             .enumerate()
             .for_each(|(i, (c, v))| {
-                let bb = &samples.bbox[i];
-                let touched = strip.is_none_or(|s| {
-                    bb.u_max >= s.u_min
-                        && bb.u_min <= s.u_max
-                        && bb.v_max >= s.v_min
-                        && bb.v_min <= s.v_max
-                });
-                if touched {
+                if touches(&samples.bbox[i], strip) {
                     (*c, *v) = samples.coefficient(i, &rect, inv, self.dev_scale);
                 }
             });
@@ -1215,6 +1228,17 @@ fn changed_strip(a: &Rect, b: &Rect) -> Option<Rect> {
         }
         _ => None,
     }
+}
+
+/// Whether a pixel whose samples' kernels span `bbox` has one in `strip` (`None`: anywhere,
+/// the change is not a strip).
+fn touches(bbox: &Rect, strip: Option<Rect>) -> bool {
+    strip.is_none_or(|s| {
+        bbox.u_max >= s.u_min
+            && bbox.u_min <= s.u_max
+            && bbox.v_max >= s.v_min
+            && bbox.v_min <= s.v_max
+    })
 }
 
 /// Half-extent given to a sample whose cell could not be measured, metres: a point, for
@@ -2044,14 +2068,10 @@ fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec
             }
             let e = r.edge(side);
             let set = st.set_of[k];
-            let (plus, plus_dev) = problem.coefficients(set, &r.with_edge(side, e + h));
-            let (minus, minus_dev) = problem.coefficients(set, &r.with_edge(side, e - h));
-            let slope = |p: &[f32], m: &[f32]| -> Vec<f32> {
-                p.iter().zip(m).map(|(p, m)| (p - m) / (2.0 * h)).collect()
-            };
-            let g = slope(&plus, &minus);
+            let (g, g_dev) =
+                problem.edge_slopes(set, &r.with_edge(side, e + h), &r.with_edge(side, e - h), h);
             if g.iter().any(|&x| x != 0.0) {
-                params.push(Param::Edge(k, side, g, slope(&plus_dev, &minus_dev)));
+                params.push(Param::Edge(k, side, g, g_dev));
             }
         }
         for ch in 0..3 {
