@@ -150,7 +150,8 @@ pub struct EdgesReport {
 #[derive(Clone, Debug, Serialize)]
 pub struct EdgeReport {
     /// "constrained" (measured from streak-edge pixels) or "unconstrained" (the streak's side
-    /// touches the photo's border or the water's end: the value is a guess).
+    /// touches the photo's border or the water's end, so the value is a guess; or the edge
+    /// faces another light split from the same streak; `reason` says which).
     pub status: String,
     /// Streak-edge pixels that constrained it.
     pub pixels: usize,

@@ -245,6 +245,28 @@ fn joint_splits_overlapping_streaks() {
     let mut joint = report.lights;
     assert_eq!(joint.len(), 2, "the joint fit splits the merged streak");
     joint.sort_by(|a, b| a.corner_left_bottom[1].total_cmp(&b.corner_left_bottom[1]));
+    // The edges the cut made (the lower light's top, the upper one's bottom) are no streak's
+    // edges: the report says so instead of repeating the merged light's status for them. The
+    // outer ones keep the merged light's (its streak's edge pixels measured them).
+    let merged = &paper.lights[0].edges;
+    for (edge, outer) in [
+        (&joint[0].edges.top, None),
+        (&joint[1].edges.bottom, None),
+        (&joint[0].edges.bottom, Some(&merged.bottom)),
+        (&joint[1].edges.top, Some(&merged.top)),
+    ] {
+        match outer {
+            None => assert!(
+                edge.status == "unconstrained"
+                    && edge
+                        .reason
+                        .as_deref()
+                        .is_some_and(|r| r.contains("split from the same streak")),
+                "{edge:?}"
+            ),
+            Some(m) => assert_eq!((&edge.status, edge.pixels), (&m.status, m.pixels)),
+        }
+    }
     for (light, truth) in joint.iter().zip(&truths) {
         let (e, r) = errors(light, truth);
         let (z, z_rad) = sigmas(light, truth);

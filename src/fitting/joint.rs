@@ -1625,10 +1625,20 @@ pub fn fit_joint(
         })
         .collect();
     optimise_seconds += t2.elapsed().as_secs_f64();
+    let facing = facing_edges(&st);
     let lights = (0..st.rects.len())
         .map(|k| {
             let origin = &start[st.set_of[k]];
             let (r, rad) = (st.rects[k], st.radiance[k]);
+            let mut edges = origin.edges.clone();
+            for side in EdgeSide::ALL {
+                if facing[k][side as usize] {
+                    edges[side as usize] = EdgeStatus::Unconstrained {
+                        reason: FACING_REASON.into(),
+                        unseen: false,
+                    };
+                }
+            }
             FittedLight {
                 streak_ids: origin.streak_ids.clone(),
                 plane: origin.plane.clone(),
@@ -1637,7 +1647,7 @@ pub fn fit_joint(
                 v_min: r.v_min,
                 v_max: r.v_max,
                 radiance: rad.map(|c| c as f32),
-                edges: origin.edges.clone(),
+                edges,
             }
         })
         .collect();
@@ -2185,6 +2195,40 @@ fn uncertainties(problem: &Problem, st: &State, extents: &[Option<Rect>]) -> Vec
                 Param::Edge(k, side, ..) => out[*k].edges[*side as usize] = Some(sd),
                 Param::Radiance(k, ch) => out[*k].radiance[*ch] = sd,
             }
+        }
+    }
+    out
+}
+
+/// Why an edge that faces another light split from the same start is reported unconstrained.
+const FACING_REASON: &str = "it faces another light split from the same streak: no streak edge \
+    shows it, and the fit places it only from where the two reflections overlap";
+
+/// Per light and edge (left, right, bottom, top), whether the edge faces another light split
+/// from the same start. The split lights' outer edges are the merged light's, measured from
+/// its streak's edge pixels; the facing ones were made by the cut, and the streak's edges say
+/// nothing about them. Two lights count as one above the other when their centres are
+/// further apart vertically than horizontally, each in units of the pair's summed size.
+fn facing_edges(st: &State) -> Vec<[bool; 4]> {
+    let n = st.rects.len();
+    let mut out = vec![[false; 4]; n];
+    for (a, facing) in out.iter_mut().enumerate() {
+        for b in (0..n).filter(|&b| b != a && st.set_of[b] == st.set_of[a]) {
+            let (ra, rb) = (st.rects[a], st.rects[b]);
+            let du = (rb.u_min + rb.u_max - ra.u_min - ra.u_max) / (ra.width() + rb.width());
+            let dv = (rb.v_min + rb.v_max - ra.v_min - ra.v_max) / (ra.height() + rb.height());
+            let side = if dv.abs() >= du.abs() {
+                if dv > 0.0 {
+                    EdgeSide::Top
+                } else {
+                    EdgeSide::Bottom
+                }
+            } else if du > 0.0 {
+                EdgeSide::Right
+            } else {
+                EdgeSide::Left
+            };
+            facing[side as usize] = true;
         }
     }
     out
