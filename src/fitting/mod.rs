@@ -16,6 +16,7 @@
 //!
 //! Fragments of one light are merged and refitted ([`fragments`]).
 
+mod control_variate;
 pub mod edges;
 pub mod footprint;
 pub mod fragments;
