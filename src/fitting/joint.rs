@@ -93,8 +93,8 @@ pub struct JointOptions {
     /// gloss search fixes it to the broadest lobe it will try.
     pub region_gloss: Option<f32>,
     /// Independent fits, each from its own samples, whose mean is the result (at least 1).
-    /// From 2 on, their spread replaces the half-sample estimate of how far the samples move
-    /// the fit ([`sample_spread`]); the mean's own error falls as one over the square root of
+    /// From 2 on, their spread is added to the uncertainties (how far the samples move the
+    /// fit); the mean's own error falls as one over the square root of
     /// the count.
     pub repeats: u32,
     /// Told a line as each repeat starts, when there are several (None: silent).
@@ -191,7 +191,7 @@ impl PlaneSamples {
     }
 
     /// `(c, d)`: the coefficient and its half-difference (see the note on the coefficients' noise).
-    fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32, dev_scale: f32) -> (f32, f32) {
+    fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> (f32, f32) {
         let r = self.range(i);
         let (mut sum, mut signed) = (0f32, 0f32);
         for (((p, h), &w), &half) in self.points[r.clone()]
@@ -209,40 +209,8 @@ impl PlaneSamples {
         }
         (
             sum * inv_samples + self.gauss[i].mass_inside(rect),
-            signed * inv_samples * dev_scale,
+            signed * inv_samples,
         )
-    }
-
-    /// The samples of one half only (those of `halves` equal to `sign`), for a refit.
-    fn half(&self, sign: f32) -> PlaneSamples {
-        let mut out = PlaneSamples {
-            offsets: vec![0],
-            bbox: self.bbox.clone(),
-            halves: Vec::new(),
-            gauss: self.gauss.clone(),
-            points: Vec::new(),
-            cells: Vec::new(),
-            weights: Vec::new(),
-            min_size: self.min_size,
-        };
-        for i in 0..self.offsets.len() - 1 {
-            let r = self.range(i);
-            for (((p, h), &w), &half) in self.points[r.clone()]
-                .iter()
-                .zip(&self.cells[r.clone()])
-                .zip(&self.weights[r.clone()])
-                .zip(&self.halves[r])
-            {
-                if half * sign > 0.0 {
-                    out.points.push(*p);
-                    out.cells.push(*h);
-                    out.weights.push(w);
-                    out.halves.push(half);
-                }
-            }
-            out.offsets.push(out.points.len() as u32);
-        }
-        out
     }
 }
 
@@ -288,9 +256,6 @@ struct Problem {
     clipped: Vec<bool>,
     planes: Vec<PlaneSamples>,
     inv_samples: f32,
-    /// 1 to remove the coefficients' noise with the halves' difference, 0 for a fit from one
-    /// half alone (which has no second half to measure it with).
-    dev_scale: f32,
 }
 
 /// The pixels of the fitted region, water only: the lights' streaks dilated by `margin`, and
@@ -895,7 +860,7 @@ impl Problem {
     fn coefficients(&self, set: usize, rect: &Rect) -> (Vec<f32>, Vec<f32>) {
         (0..self.n())
             .into_par_iter()
-            .map(|i| self.planes[set].coefficient(i, rect, self.inv_samples, self.dev_scale))
+            .map(|i| self.planes[set].coefficient(i, rect, self.inv_samples))
             .unzip()
     }
 
@@ -920,8 +885,8 @@ impl Problem {
                         0.0,
                     );
                 }
-                let (p, p_dev) = samples.coefficient(i, plus, self.inv_samples, self.dev_scale);
-                let (m, m_dev) = samples.coefficient(i, minus, self.inv_samples, self.dev_scale);
+                let (p, p_dev) = samples.coefficient(i, plus, self.inv_samples);
+                let (m, m_dev) = samples.coefficient(i, minus, self.inv_samples);
                 ((p - m) / (2.0 * h), (p_dev - m_dev) / (2.0 * h))
             })
             .unzip()
@@ -941,7 +906,7 @@ impl Problem {
             .enumerate()
             .for_each(|(i, (c, v))| {
                 if touches(&samples.bbox[i], strip) {
-                    (*c, *v) = samples.coefficient(i, &rect, inv, self.dev_scale);
+                    (*c, *v) = samples.coefficient(i, &rect, inv);
                 } else {
                     // Only the Gaussian can reach the strip: update its exact mass, without
                     // going through the samples (in f64; the f32 rounding this repeats is
@@ -1170,11 +1135,7 @@ impl Problem {
                 // Only the Gaussian moves: the samples' part is what it is now.
                 let inv = self.inv_samples as f64;
                 let sampled = st.coef[k][i] as f64 - g.mass_inside(&rect) as f64;
-                let dev = if self.dev_scale > 0.0 {
-                    st.dev[k][i] as f64 / (inv * self.dev_scale as f64)
-                } else {
-                    0.0
-                };
+                let dev = st.dev[k][i] as f64 / inv;
                 ramps.constant(sampled / inv, dev);
                 any = true;
             }
@@ -1212,7 +1173,7 @@ impl Problem {
                 let [c, d] = ramps.constant;
                 let inv = self.inv_samples as f64;
                 let c = c * inv + g.mass_inside(&rect) as f64;
-                same_everywhere(c, d * inv * self.dev_scale as f64, &mut flat);
+                same_everywhere(c, d * inv, &mut flat);
                 continue;
             }
             ramps.values(&mut cvals, &mut half_difference);
@@ -1244,7 +1205,7 @@ impl Problem {
                 let cf = cvals[j] * self.inv_samples;
                 let c = cf as f64;
                 a_raw[j] += c * c;
-                let d = (half_difference[j] * self.inv_samples * self.dev_scale) as f64;
+                let d = (half_difference[j] * self.inv_samples) as f64;
                 a[j] += c * c - d * d;
                 for ch in 0..3 {
                     b[j][ch] += c * res[ch] + d * rest_dev[ch];
@@ -1730,7 +1691,6 @@ pub fn fit_joint(
             clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
             planes: stored,
             inv_samples: 1.0 / per_pixel_samples as f32,
-            dev_scale: 1.0,
         }
     };
     let problem = problem_for(0);
@@ -1759,7 +1719,13 @@ pub fn fit_joint(
     }
     let t2 = Instant::now();
     let (st, spread) = if repeats.len() == 1 {
-        let spread = sample_spread(&problem, &first, &extents);
+        // One fit: the curvature alone (see `uncertainties`). Until the control variate, the
+        // samples' own noise moved the fit further than the curvature said, and the spread of
+        // two refits, one from each half of the samples, was added; with it, the curvature
+        // alone covers the errors (8 seeds through the pipeline: Table 3 0.5-1.3 sigma rms,
+        // largest 2.1; the stacked sample 0.3-1.2, largest 1.8), and the refits, 0.7 s of
+        // Table 3's fit, only widened the sigmas further (BENCHMARKS.md, ninth session).
+        let spread = vec![([0f32; 4], [0f32; 3]); first.rects.len()];
         (first, spread)
     } else {
         let (rects, radiance, spread) = mean_and_spread(&repeats);
@@ -2122,80 +2088,6 @@ impl Problem {
     }
 }
 
-/// Sweeps of each half's refit in [`sample_spread`]: they start at the optimum with windows
-/// of a tenth of the light's size. Two were enough for Table 3's light0 (its errors 0.8-1.2
-/// sigma rms over 8 seeds with 2, 3, 4 and 10 sweeps alike), but not for light1, whose height
-/// trades against its radiance and whose refits travel that valley slowly: through the
-/// pipeline on a 4096-spp render of Table 3, seeds 1-8, light1's bottom / top / radiance
-/// errors came out 2.8 / 4.7 / 3.9 sigma rms with 2 sweeps, 3.0 / 4.8 / 4.2 with 3,
-/// 3.6 / 2.1 / 2.7 with 4, 3.1 / 1.6 / 2.2 with 5, 2.7 / 1.5 / 2.1 with 10 and 20
-/// (BENCHMARKS.md, seventh session).
-const SPREAD_SWEEPS: u32 = 5;
-
-/// Grid points per edge in [`sample_spread`]'s refits, against [`GRID`] in the fit: their
-/// windows start at a tenth of the light's size, not half, so 17 points are as fine as the
-/// fit's 65 were in its first sweep, and the refits' extra sweeps cost less (the Table 3
-/// benchmark's joint optimisation: 1.53 s with 2 sweeps at 65 points, 1.94 s with 5 at 65,
-/// 1.74 s with 5 at 17). The sigmas above were measured at 65 points; at 17, with 5 sweeps,
-/// light1's came out 1.8 / 1.0 / 1.6 rms and light0's 1.0-1.7.
-const SPREAD_GRID: usize = 17;
-
-/// How far the fit's own samples move its result: the fit repeated from each independent half
-/// of the samples alone, starting at the optimum, and half the two refits' difference taken
-/// per parameter (edges in metres, radiance per channel). For independent halves, E[(a - b)^2]
-/// / 4 is half one half's variance, which is about the variance of the fit from both.
-///
-/// The samples are common to every rectangle the fit tries, so their noise shapes the cost
-/// itself, and along a weakly seen direction (a light's height against its radiance when the
-/// photo's border cuts its streak) the optimum follows it. Since the curvature is taken from
-/// the noise-corrected cost (see `uncertainties`) it carries most of this too; the refits
-/// still widen light0's sigmas on Table 3 from 1.2-1.6 to a better-calibrated 0.9-1.5 rms
-/// (BENCHMARKS.md, seventh session). A half alone cannot remove its coefficients' noise (that takes both), so
-/// each refit carries the same bias; the difference cancels it.
-fn sample_spread(
-    problem: &Problem,
-    st: &State,
-    extents: &[Option<Rect>],
-) -> Vec<([f32; 4], [f32; 3])> {
-    let refits: Vec<State> = [1.0f32, -1.0]
-        .par_iter()
-        .map(|&sign| {
-            let half = Problem {
-                width: problem.width,
-                pixel_ids: problem.pixel_ids.clone(),
-                obs: problem.obs.clone(),
-                clipped: problem.clipped.clone(),
-                planes: problem.planes.iter().map(|p| p.half(sign)).collect(),
-                inv_samples: 2.0 * problem.inv_samples,
-                dev_scale: 0.0,
-            };
-            let mut refit = half.state(
-                st.set_of.clone(),
-                st.pinned.clone(),
-                st.rects.clone(),
-                st.radiance.clone(),
-            );
-            let windows = st
-                .rects
-                .iter()
-                .map(|r| [(0.1 * r.width().max(r.height())).max(0.05); 4])
-                .collect();
-            half.descend_from(&mut refit, extents, SPREAD_SWEEPS, windows, SPREAD_GRID);
-            refit
-        })
-        .collect();
-    let (a, b) = (&refits[0], &refits[1]);
-    (0..st.rects.len())
-        .map(|k| {
-            let edges = EdgeSide::ALL
-                .map(|side| 0.5 * (a.rects[k].edge(side) - b.rects[k].edge(side)).abs());
-            let radiance =
-                [0, 1, 2].map(|c| (0.5 * (a.radiance[k][c] - b.radiance[k][c]).abs()) as f32);
-            (edges, radiance)
-        })
-        .collect()
-}
-
 /// Where an edge may go: inside the samples' extent (with a millimetre to spare) and no
 /// nearer the opposite edge than `min_size` ([`smallest_light`]).
 fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect, min_size: Vec2) -> (f32, f32) {
@@ -2483,8 +2375,8 @@ mod tests {
             let inv = 1.0 / *n as f32;
             (0..pixels.len())
                 .map(|i| {
-                    let (c, _) = planes[0].coefficient(i, &rect, inv, 1.0);
-                    let (m, _) = planes[0].coefficient(i, &moved, inv, 1.0);
+                    let (c, _) = planes[0].coefficient(i, &rect, inv);
+                    let (m, _) = planes[0].coefficient(i, &moved, inv);
                     (c as f64, (m - c) as f64)
                 })
                 .collect()
