@@ -19,6 +19,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::joint::plane_point;
 use super::light_plane::LightPlane;
 use super::rect::Rect;
 use crate::optics::{compact_strata, ReflectionModel};
@@ -157,16 +158,6 @@ pub(super) fn lobe_directions(
         })
         .collect();
     (dirs, (GRID * GRID) as usize)
-}
-
-/// Plane coordinates where the ray from `start` along `dir` meets `plane`'s front side.
-fn plane_point(plane: &LightPlane, start: Vec3, dir: Vec3) -> Option<Vec2> {
-    let denom = dir.dot(plane.normal);
-    if denom >= 0.0 {
-        return None;
-    }
-    let t = (plane.point - start).dot(plane.normal) / denom;
-    (t > 0.0).then(|| plane.coords(start + dir * t))
 }
 
 /// The normal distribution's mass between `lo` and `hi`.

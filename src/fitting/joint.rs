@@ -728,7 +728,7 @@ fn shuffle(items: &mut [u32], rng: &mut Rng) {
 
 /// Plane coordinates where the ray from `start` along `dir` meets `plane`'s front side, if it
 /// does.
-fn plane_point(plane: &LightPlane, start: Vec3, dir: Vec3) -> Option<Vec2> {
+pub(super) fn plane_point(plane: &LightPlane, start: Vec3, dir: Vec3) -> Option<Vec2> {
     plane_distance(plane, start, dir).map(|t| plane.coords(start + dir * t))
 }
 
@@ -1105,7 +1105,9 @@ impl Problem {
             // changes at all it is counted exactly: treating small changes as none made the
             // profiles disagree with the coefficients they stand for, and the descent took
             // more sweeps to a worse end (Table 3, threshold 1e-4 of the lobe).
-            let (g_across, g_mean, g_sd) = if along_u {
+            let (g_across, g_mean, g_sd) = if g.is_none() {
+                (0.0, 0.0, 1.0)
+            } else if along_u {
                 (g.share_v(o_lo, o_hi), g.mean.x, g.sd.x)
             } else {
                 (g.share_u(o_lo, o_hi), g.mean.y, g.sd.y)
