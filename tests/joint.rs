@@ -129,9 +129,9 @@ fn joint_fits_table1() {
         );
     }
     assert!(jr < LIGHT0_BOUND, "radiance off by {:.3} %", 100.0 * jr);
-    // The reported uncertainties (curvature and the spread of refits from each half of the
-    // samples) cover the real errors: over 8 seeds light0's errors were 0.3-1.0 sigma rms,
-    // at most 1.5 (without the control variate 1.0-2.3, at most 4.3).
+    // The reported uncertainties (the curvature of the noise-corrected cost) cover the real
+    // errors: over 8 seeds light0's errors were 0.5-1.3 sigma rms, at most 2.1 (without the
+    // control variate, with refits from each half of the samples: 1.0-2.3, at most 4.3).
     let (se, sr) = sigmas(&joint[0], &truth);
     eprintln!("table1: errors in sigmas {se:?}, radiance {sr:.2}");
     assert!(
@@ -194,9 +194,9 @@ fn joint_fits_table3() {
         );
     }
     assert!(r1 < 0.018, "light1 radiance off by {:.3} %", 100.0 * r1);
-    // Uncertainties: both lights' errors within 5 sigma. Over 8 seeds the largest was 1.5
-    // sigma for either light (without the control variate 2.8 for light0 and 1.5 for
-    // light1); light1's reached 6.9 while the curvature counted
+    // Uncertainties: both lights' errors within 5 sigma. Over 8 seeds the largest was 2.1
+    // sigma for light0 and 1.6 for light1 (without the control variate 2.8 and 1.5);
+    // light1's reached 6.9 while the curvature counted
     // the samples' noise in the derivatives as curvature, and 12.8 with 2-sweep half refits
     // (BENCHMARKS.md, seventh session).
     let (s0, sr0) = sigmas(&joint[0], &truths[0]);
