@@ -1727,8 +1727,7 @@ pub fn fit_joint(
         // alone covers the errors (8 seeds through the pipeline: Table 3 0.5-1.3 sigma rms,
         // largest 2.1; the stacked sample 0.3-1.2, largest 1.8), and the refits, 0.7 s of
         // Table 3's fit, only widened the sigmas further (BENCHMARKS.md, ninth session).
-        let spread = vec![([0f32; 4], [0f32; 3]); first.rects.len()];
-        (first, spread)
+        (first, None)
     } else {
         let (rects, radiance, spread) = mean_and_spread(&repeats);
         let st = problem.state(
@@ -1738,19 +1737,17 @@ pub fn fit_joint(
             radiance.clone(),
         );
         // The mean's radiances, not the ones the first fit's samples would give its edges.
-        (State { radiance, ..st }, spread)
+        (State { radiance, ..st }, Some(spread))
     };
     let cost = problem.cost(&st);
     let dof = (problem.n() * 3).saturating_sub(7 * st.rects.len()).max(1) as f64;
     let variance = (cost / dof).max(f64::MIN_POSITIVE);
-    let uncertainty = uncertainties(&problem, &st, &extents)
-        .into_iter()
-        .zip(spread)
-        .map(|(u, (edges, radiance))| Uncertainty {
-            edges: [0, 1, 2, 3].map(|e| u.edges[e].map(|sd| sd.hypot(edges[e]))),
-            radiance: [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c])),
-        })
-        .collect();
+    let mut uncertainty = uncertainties(&problem, &st, &extents);
+    // The repeats' spread, where there are several, adds to the curvature's.
+    for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
+        u.edges = [0, 1, 2, 3].map(|e| u.edges[e].map(|sd| sd.hypot(edges[e])));
+        u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
+    }
     optimise_seconds += t2.elapsed().as_secs_f64();
     let facing = facing_edges(&st);
     let lights = (0..st.rects.len())
@@ -1877,20 +1874,8 @@ impl Problem {
     /// sweeps, stopping early once every search window has shrunk to its minimum.
     fn descend(&self, st: &mut State, extents: &[Option<Rect>], sweeps: u32) {
         // Initial half-windows: see `first_window`.
-        let windows = st.rects.iter().map(|r| [first_window(r); 4]).collect();
-        self.descend_from(st, extents, sweeps, windows, GRID);
-    }
-
-    /// [`Problem::descend`] with the given initial half-windows per light and edge, and `grid`
-    /// points per edge search.
-    fn descend_from(
-        &self,
-        st: &mut State,
-        extents: &[Option<Rect>],
-        sweeps: u32,
-        mut windows: Vec<[f32; 4]>,
-        grid: usize,
-    ) {
+        let mut windows: Vec<[f32; 4]> = st.rects.iter().map(|r| [first_window(r); 4]).collect();
+        let grid = GRID;
         for _sweep in 0..sweeps {
             for k in 0..st.rects.len() {
                 let Some(ext) = extents[st.set_of[k]] else {
@@ -2476,8 +2461,7 @@ mod tests {
             v_min: 2.0 * v,
             v_max: 3.0,
         };
-        // Two fits: the standard error of their mean is half their difference, the
-        // convention of the half-sample spread.
+        // Two fits: the standard error of their mean is half their difference.
         let (rects, radiance, spread) = mean_and_spread(&[
             (vec![rect(0.0)], vec![[1.0, 2.0, 3.0]]),
             (vec![rect(0.5)], vec![[3.0, 2.0, 0.0]]),
