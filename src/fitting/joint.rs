@@ -43,7 +43,9 @@
 //! Overlapping streaks (two lights whose reflections merge into one region, the paper's
 //! §5.3): when the residual of a fit is structured along the image rows, each light is tried
 //! as two (one above the other, or side by side), and the split is kept when it removes most
-//! of that structure.
+//! of that structure. The second light of a split then reads a sample set of its own, drawn
+//! independently on the same plane, and the boundary between the two is searched globally
+//! before the final descent (`search_boundary`).
 
 use std::time::Instant;
 
@@ -212,6 +214,61 @@ impl PlaneSamples {
             signed * inv_samples,
         )
     }
+
+    /// Pixel i's coefficient and half-difference, as [`Self::coefficient`] gives them, with
+    /// `rect`'s edge `side` at every grid point `lo + j step` (`coef.len()` of them), in one
+    /// pass over its samples (see [`EdgeRamps`]).
+    #[allow(clippy::too_many_arguments)]
+    fn edge_coefficients(
+        &self,
+        i: usize,
+        rect: &Rect,
+        side: EdgeSide,
+        lo: f32,
+        step: f32,
+        inv_samples: f32,
+        ramps: &mut EdgeRamps,
+        coef: &mut [f32],
+        dev: &mut [f32],
+    ) {
+        let along_u = matches!(side, EdgeSide::Left | EdgeSide::Right);
+        let (min_edge, opp, o_lo, o_hi) = match side {
+            EdgeSide::Left => (true, rect.u_max, rect.v_min, rect.v_max),
+            EdgeSide::Right => (false, rect.u_min, rect.v_min, rect.v_max),
+            EdgeSide::Bottom => (true, rect.v_max, rect.u_min, rect.u_max),
+            EdgeSide::Top => (false, rect.v_min, rect.u_min, rect.u_max),
+        };
+        ramps.clear(coef.len());
+        let r = self.range(i);
+        for (((p, h), &w), &half) in self.points[r.clone()]
+            .iter()
+            .zip(&self.cells[r.clone()])
+            .zip(&self.weights[r.clone()])
+            .zip(&self.halves[r])
+        {
+            let (x, hx, y, hy) = if along_u {
+                (p.x, h.x, p.y, h.y)
+            } else {
+                (p.y, h.y, p.x, h.x)
+            };
+            let across = kernel_coverage(y, hy, o_lo, o_hi);
+            if across != 0.0 {
+                let weight = (w * across) as f64;
+                ramps.add_cell(min_edge, x, hx, opp, weight, weight * half as f64);
+            }
+        }
+        ramps.values(coef, dev);
+        let g = &self.gauss[i];
+        for (j, (c, d)) in coef.iter_mut().zip(dev.iter_mut()).enumerate() {
+            let mass = if g.is_none() {
+                0.0
+            } else {
+                g.mass_inside(&rect.with_edge(side, lo + j as f32 * step))
+            };
+            *c = *c * inv_samples + mass;
+            *d *= inv_samples;
+        }
+    }
 }
 
 // The noise of the coefficients, and why the fit must remove it.
@@ -255,6 +312,9 @@ struct Problem {
     obs: Vec<[f32; 3]>,
     clipped: Vec<bool>,
     planes: Vec<PlaneSamples>,
+    /// Per sample set, the start light whose plane it samples (a split light reads a set of
+    /// its own, drawn independently on the same plane).
+    set_origin: Vec<usize>,
     inv_samples: f32,
 }
 
@@ -413,6 +473,7 @@ fn trace_samples(
     samples: u32,
     seed: u64,
     repeat: u32,
+    draw: u32,
     gaussians: bool,
 ) -> (Vec<PlaneSamples>, u32) {
     type Hits = (Vec<(u16, Vec2, Vec2, f32, f32)>, Vec<LobeGaussian>);
@@ -421,7 +482,8 @@ fn trace_samples(
     let per_pixel: Vec<Hits> = pixels
         .par_iter()
         .map(|&pixel| {
-            let mut rng = Rng::new(seed, JOINT_STREAM | (repeat as u64) << 32 | pixel as u64);
+            let stream = JOINT_STREAM | (draw as u64) << 52 | (repeat as u64) << 32 | pixel as u64;
+            let mut rng = Rng::new(seed, stream);
             let (x, y) = (pixel % width, pixel / width);
             let mut hits = Vec::new();
             let mut missed_water = 0u32;
@@ -1684,6 +1746,7 @@ pub fn fit_joint(
             options.samples,
             options.seed,
             repeat,
+            0,
             options.control_variate,
         );
         Problem {
@@ -1692,14 +1755,46 @@ pub fn fit_joint(
             obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
             clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
             planes: stored,
+            set_origin: (0..planes.len()).collect(),
             inv_samples: 1.0 / per_pixel_samples as f32,
         }
     };
-    let problem = problem_for(0);
+    // Seconds spent tracing the split lights' own sample sets (footprints, not optimisation).
+    let fresh_seconds = std::cell::Cell::new(0.0);
+    // The `draw`-th extra sample set of repeat `repeat`, on start light `origin`'s plane,
+    // independent of every other set.
+    let fresh_set = |repeat: u32, origin: usize, draw: u32| {
+        let t = Instant::now();
+        let (mut stored, _) = trace_samples(
+            scene,
+            &options.model,
+            &[planes[origin]],
+            &[roi[origin]],
+            &pixels,
+            photo.width,
+            photo.height,
+            options.samples,
+            options.seed,
+            repeat,
+            draw,
+            options.control_variate,
+        );
+        fresh_seconds.set(fresh_seconds.get() + t.elapsed().as_secs_f64());
+        // One plane in, one set out.
+        stored.swap_remove(0)
+    };
+    let mut problem = problem_for(0);
     let mut footprint_seconds = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
-    let (first, replay) = optimise(&problem, start, &extents, options.sweeps, options.split);
+    let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
+    let (first, replay) = optimise(
+        &mut problem,
+        start,
+        &mut extents,
+        options.sweeps,
+        options.split,
+        &|origin, draw| fresh_set(0, origin, draw),
+    );
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
     for repeat in 1..options.repeats {
@@ -1711,14 +1806,18 @@ pub fn fit_joint(
             ));
         }
         let t = Instant::now();
-        let again = problem_for(repeat);
+        let mut again = problem_for(repeat);
         footprint_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let extents: Vec<Option<Rect>> = again.planes.iter().map(sample_extent).collect();
-        let st = again.replay(&replay, &extents, options.sweeps);
+        let mut extents: Vec<Option<Rect>> = again.planes.iter().map(sample_extent).collect();
+        let st = again.replay(&replay, &mut extents, options.sweeps, &|origin, draw| {
+            fresh_set(repeat, origin, draw)
+        });
         repeats.push((st.rects, st.radiance));
         optimise_seconds += t.elapsed().as_secs_f64();
     }
+    footprint_seconds += fresh_seconds.get();
+    optimise_seconds -= fresh_seconds.get();
     let t2 = Instant::now();
     let (st, spread) = if repeats.len() == 1 {
         // One fit: the curvature alone (see `uncertainties`). Until the control variate, the
@@ -1749,10 +1848,10 @@ pub fn fit_joint(
         u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
     }
     optimise_seconds += t2.elapsed().as_secs_f64();
-    let facing = facing_edges(&st);
+    let facing = facing_edges(&problem, &st);
     let lights = (0..st.rects.len())
         .map(|k| {
-            let origin = &start[st.set_of[k]];
+            let origin = &start[problem.set_origin[st.set_of[k]]];
             let (r, rad) = (st.rects[k], st.radiance[k]);
             let mut edges = origin.edges.clone();
             for side in EdgeSide::ALL {
@@ -1951,28 +2050,33 @@ const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
 /// (overlapping streaks merge into one region, METHOD §5 and the paper's §5.3): each
 /// candidate starts from the rectangle cut in half and is fitted coarsely. Returns the
 /// candidate with the lowest row-summed cost when it is below
-/// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's.
+/// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, and the two edges that face each
+/// other (the first light's, then the second's, the new light last in the state). This only
+/// decides whether and which way to split: where the two lights meet is
+/// [`search_boundary`]'s work.
 fn try_split(
     problem: &Problem,
     st: &State,
     k: usize,
     extents: &[Option<Rect>],
-) -> Option<(State, State)> {
+) -> Option<(State, [EdgeSide; 2])> {
     let r = st.rects[k];
     let halves = [
         // One above the other.
         (
             r.with_edge(EdgeSide::Top, 0.5 * (r.v_min + r.v_max)),
             r.with_edge(EdgeSide::Bottom, 0.5 * (r.v_min + r.v_max)),
+            [EdgeSide::Top, EdgeSide::Bottom],
         ),
         // Side by side.
         (
             r.with_edge(EdgeSide::Right, 0.5 * (r.u_min + r.u_max)),
             r.with_edge(EdgeSide::Left, 0.5 * (r.u_min + r.u_max)),
+            [EdgeSide::Right, EdgeSide::Left],
         ),
     ];
-    let mut best: Option<(State, State, f64)> = None;
-    for (first, second) in halves {
+    let mut best: Option<(State, [EdgeSide; 2], f64)> = None;
+    for (first, second, inner) in halves {
         let mut set_of = st.set_of.clone();
         let mut pinned = st.pinned.clone();
         let mut rects = st.rects.clone();
@@ -1982,39 +2086,358 @@ fn try_split(
         set_of.push(st.set_of[k]);
         pinned.push(st.pinned[k]);
         radiance.push(st.radiance[k]);
-        let cut = problem.state(set_of, pinned, rects, radiance);
-        let mut trial = cut.clone();
+        let mut trial = problem.state(set_of, pinned, rects, radiance);
         problem.descend(&mut trial, extents, SPLIT_TRIAL_SWEEPS);
         let c = problem.row_cost(&trial);
         let both_lit = [k, trial.rects.len() - 1]
             .iter()
             .all(|&j| trial.radiance[j].iter().any(|&l| l > 0.0));
         if both_lit && best.as_ref().is_none_or(|(_, _, b)| c < *b) {
-            best = Some((trial, cut, c));
+            best = Some((trial, inner, c));
         }
     }
     let before = problem.row_cost(st);
     best.filter(|(_, _, c)| *c < SPLIT_MIN_ROW_COST_RATIO * before)
-        .map(|(trial, cut, _)| (trial, cut))
+        .map(|(trial, inner, _)| (trial, inner))
 }
 
-/// How a fit reached its optimum, for repeating it on other samples: the state its
-/// descent started from (the start, or the split it kept, cut but not yet fitted) and
-/// whether that was a split (whose trial descent a repeat runs too).
+/// Grid points per inner edge in [`search_boundary`].
+const BOUNDARY_GRID: usize = 33;
+
+/// Positions of each outer edge in [`search_boundary`], around where the split's coarse fit
+/// put it, and their spacing as a fraction of the two lights' span.
+const OUTER_GRID: usize = 5;
+const OUTER_STEP: f32 = 0.015;
+
+/// Places the boundary between lights `a` and `b`, split from one light (`inner`: a's edge
+/// and b's edge that face each other), by a global search: every pair of positions of the
+/// two inner edges on a grid across their span (a's inner edge never past b's), each with
+/// the two outer edges across that axis at a few positions around where they are, both
+/// radiances re-solved for each combination. The lowest [`BOUNDARY_STARTS`] local minima of
+/// that cost are each refined by the same search on a finer grid around them; returns the
+/// refined states, lowest coarse minimum first. The split's coarse descent from the half cut cannot do this: the
+/// boundary hardly moves from where the cut put it (moving one inner edge alone opens a gap
+/// or an overlap), the outer edges have settled to match it, and the half cut lies in
+/// another basin than the truth's (BENCHMARKS.md, the stacked sample). The other lights stay
+/// where they are; clipped pixels are left out of the search (the descent after it counts
+/// them as lower bounds).
+fn search_boundary(
+    problem: &Problem,
+    st: &State,
+    a: usize,
+    b: usize,
+    inner: [EdgeSide; 2],
+) -> Vec<State> {
+    let coarse = boundary_minima(problem, st, a, b, inner, None, BOUNDARY_GRID, OUTER_STEP);
+    coarse
+        .iter()
+        .take(BOUNDARY_STARTS)
+        .filter_map(|&(rects, _, window)| {
+            let mut cand = st.clone();
+            problem.set_rect(&mut cand, a, rects[0]);
+            problem.set_rect(&mut cand, b, rects[1]);
+            let fine = boundary_minima(
+                problem,
+                &cand,
+                a,
+                b,
+                inner,
+                Some(window),
+                FINE_GRID,
+                OUTER_STEP / 2.0,
+            );
+            let &(rects, _, _) = fine.first()?;
+            problem.set_rect(&mut cand, a, rects[0]);
+            problem.set_rect(&mut cand, b, rects[1]);
+            problem.solve_radiance(&mut cand);
+            Some(cand)
+        })
+        .collect()
+}
+
+/// Grid points per inner edge of the refining search around each coarse minimum.
+const FINE_GRID: usize = 13;
+
+/// The local minima of the boundary search's cost (see [`search_boundary`]), lowest first:
+/// the two rectangles, the cost, and the half-window a finer search around the minimum
+/// should cover (one and a half grid steps of the inner edges). The
+/// inner edges range over their whole span (`window` None) or over +-`window` about their
+/// current positions, on `grid` points each; the outer edges over [`OUTER_GRID`] positions
+/// `outer_step` of the span apart.
+#[allow(clippy::too_many_arguments)]
+fn boundary_minima(
+    problem: &Problem,
+    st: &State,
+    a: usize,
+    b: usize,
+    inner: [EdgeSide; 2],
+    window: Option<f32>,
+    grid: usize,
+    outer_step: f32,
+) -> Vec<([Rect; 2], f64, f32)> {
+    let (ra, rb) = (st.rects[a], st.rects[b]);
+    let outer = [inner[1], inner[0]];
+    let (set_a, set_b) = (st.set_of[a], st.set_of[b]);
+    let vertical = inner[0] == EdgeSide::Top;
+    let min_size = |set: usize| {
+        let m = problem.planes[set].min_size;
+        if vertical {
+            m.y
+        } else {
+            m.x
+        }
+    };
+    let (start_a, end_b) = (ra.edge(outer[0]), rb.edge(outer[1]));
+    let span = end_b - start_a;
+    let (lo, hi) = (start_a + min_size(set_a), end_b - min_size(set_b));
+    if hi <= lo {
+        return Vec::new();
+    }
+    // Positions of a's inner edge (`at_a`) and b's (`at_b`): a common grid over the span, or
+    // each about its current place.
+    let (step, base_a, base_b) = match window {
+        None => ((hi - lo) / (grid - 1) as f32, lo, lo),
+        Some(w) => (
+            2.0 * w / (grid - 1) as f32,
+            ra.edge(inner[0]) - w,
+            rb.edge(inner[1]) - w,
+        ),
+    };
+    let at_a = |j: usize| base_a + j as f32 * step;
+    let at_b = |j: usize| base_b + j as f32 * step;
+    let offset = |o: usize| (o as f32 - (OUTER_GRID / 2) as f32) * outer_step * span;
+    let n = problem.n();
+    let used: Vec<usize> = (0..n).filter(|&i| !problem.clipped[i]).collect();
+    // The photo less the other lights, and the other lights' half-difference, per pixel.
+    let (target, rest_dev): (Vec<[f64; 3]>, Vec<[f64; 3]>) = used
+        .iter()
+        .map(|&i| {
+            let (mut rest, mut dev) = ([0f64; 3], [0f64; 3]);
+            for (k, l) in st.radiance.iter().enumerate() {
+                if k != a && k != b {
+                    for ch in 0..3 {
+                        rest[ch] += l[ch] * st.coef[k][i] as f64;
+                        dev[ch] += l[ch] * st.dev[k][i] as f64;
+                    }
+                }
+            }
+            (
+                [0, 1, 2].map(|ch| problem.obs[i][ch] as f64 - rest[ch]),
+                dev,
+            )
+        })
+        .unzip();
+    // Per (outer offset, inner position) of one light: its coefficients and half-differences
+    // on the used pixels, its terms of the normal equations, and its raw diagonal (0 where
+    // the rectangle would be too small).
+    struct Column {
+        coef: Vec<f32>,
+        dev: Vec<f32>,
+        rhs: [f64; 3],
+        diag: f64,
+        raw: f64,
+    }
+    let empty = || Column {
+        coef: Vec::new(),
+        dev: Vec::new(),
+        rhs: [0.0; 3],
+        diag: 0.0,
+        raw: 0.0,
+    };
+    // Per outer offset, one pass over each pixel's samples gives its coefficient at every
+    // inner position (edge ramps); then the columns' sums.
+    let columns = |set: usize, r: Rect, outer: EdgeSide, inner: EdgeSide, base: f32| {
+        let samples = &problem.planes[set];
+        let mut out = Vec::with_capacity(OUTER_GRID * grid);
+        for o in 0..OUTER_GRID {
+            let r_o = r.with_edge(outer, r.edge(outer) + offset(o));
+            let rows: Vec<(Vec<f32>, Vec<f32>)> = used
+                .par_iter()
+                .map_init(
+                    || EdgeRamps::new(base, step, grid),
+                    |ramps, &i| {
+                        let (mut c, mut d) = (vec![0f32; grid], vec![0f32; grid]);
+                        samples.edge_coefficients(
+                            i,
+                            &r_o,
+                            inner,
+                            base,
+                            step,
+                            problem.inv_samples,
+                            ramps,
+                            &mut c,
+                            &mut d,
+                        );
+                        (c, d)
+                    },
+                )
+                .collect();
+            for j in 0..grid {
+                let t = base + j as f32 * step;
+                let rect = r_o.with_edge(inner, t);
+                let size = if vertical {
+                    rect.v_max - rect.v_min
+                } else {
+                    rect.u_max - rect.u_min
+                };
+                if !(lo..=hi).contains(&t) || size < min_size(set) {
+                    out.push(empty());
+                    continue;
+                }
+                let coef: Vec<f32> = rows.iter().map(|row| row.0[j]).collect();
+                let dev: Vec<f32> = rows.iter().map(|row| row.1[j]).collect();
+                let mut rhs = [0f64; 3];
+                let (mut diag, mut raw) = (0f64, 0f64);
+                for (u, (&c, &d)) in coef.iter().zip(&dev).enumerate() {
+                    let (c, d) = (c as f64, d as f64);
+                    for ch in 0..3 {
+                        rhs[ch] += target[u][ch] * c + rest_dev[u][ch] * d;
+                    }
+                    diag += c * c - d * d;
+                    raw += c * c;
+                }
+                out.push(Column {
+                    coef,
+                    dev,
+                    rhs,
+                    diag: diag.max(0.5 * raw),
+                    raw,
+                });
+            }
+        }
+        out
+    };
+    let col_a = columns(set_a, ra, outer[0], inner[0], base_a);
+    let col_b = columns(set_b, rb, outer[1], inner[1], base_b);
+    // The cost, less its constant part, with both radiances at their nonnegative optimum:
+    // per channel min over L >= 0 of L^T A L - 2 L . g.
+    let pair_cost = |xa: usize, xb: usize| -> f64 {
+        let (ca, cb) = (&col_a[xa], &col_b[xb]);
+        if ca.raw == 0.0 || cb.raw == 0.0 {
+            return f64::INFINITY;
+        }
+        let cross: f64 = ca
+            .coef
+            .iter()
+            .zip(&cb.coef)
+            .zip(ca.dev.iter().zip(&cb.dev))
+            .map(|((&x, &y), (&dx, &dy))| x as f64 * y as f64 - dx as f64 * dy as f64)
+            .sum();
+        let (aa, bb) = (ca.diag, cb.diag);
+        (0..3)
+            .map(|ch| {
+                let (ga, gb) = (ca.rhs[ch], cb.rhs[ch]);
+                let det = aa * bb - cross * cross;
+                let mut best = 0f64;
+                if det > 0.0 {
+                    let la = (bb * ga - cross * gb) / det;
+                    let lb = (aa * gb - cross * ga) / det;
+                    if la >= 0.0 && lb >= 0.0 {
+                        best = best.min(-(la * ga + lb * gb));
+                    }
+                }
+                if ga > 0.0 {
+                    best = best.min(-ga * ga / aa);
+                }
+                if gb > 0.0 {
+                    best = best.min(-gb * gb / bb);
+                }
+                best
+            })
+            .sum()
+    };
+    // Grid coordinates: a's outer offset, a's inner position, b's inner position, b's outer
+    // offset.
+    type Point = [usize; 4];
+    let points: Vec<Point> = (0..OUTER_GRID)
+        .flat_map(|oa| {
+            (0..grid).flat_map(move |ja| {
+                (0..grid).flat_map(move |jb| (0..OUTER_GRID).map(move |ob| [oa, ja, jb, ob]))
+            })
+        })
+        .filter(|p| at_a(p[1]) <= at_b(p[2]))
+        .collect();
+    let costs: Vec<f64> = points
+        .par_iter()
+        .map(|p| pair_cost(p[0] * grid + p[1], p[3] * grid + p[2]))
+        .collect();
+    let index: std::collections::HashMap<Point, f64> =
+        points.iter().copied().zip(costs.iter().copied()).collect();
+    // The local minima: no lower neighbour in the 4-D grid.
+    let mut minima: Vec<(Point, f64)> = index
+        .par_iter()
+        .filter(|(p, &c)| {
+            c.is_finite()
+                && (0..81).all(|d| {
+                    let q = [0, 1, 2, 3]
+                        .map(|axis| p[axis] as i64 + (d / 3i64.pow(axis as u32)) % 3 - 1);
+                    q.iter().any(|&x| x < 0)
+                        || index.get(&q.map(|x| x as usize)).is_none_or(|&qc| qc >= c)
+                })
+        })
+        .map(|(p, &c)| (*p, c))
+        .collect();
+    minima.sort_by(|x, y| x.1.total_cmp(&y.1));
+    minima
+        .iter()
+        .map(|&(p, c)| {
+            let new_a = ra
+                .with_edge(outer[0], ra.edge(outer[0]) + offset(p[0]))
+                .with_edge(inner[0], at_a(p[1]));
+            let new_b = rb
+                .with_edge(outer[1], rb.edge(outer[1]) + offset(p[3]))
+                .with_edge(inner[1], at_b(p[2]));
+            ([new_a, new_b], c, 1.5 * step)
+        })
+        .collect()
+}
+
+/// How many of the boundary search's lowest local minima are refined and descended from
+/// (the search's cost leaves out clipped pixels and holds the other edges, so its ranking
+/// is not final; on the stacked sample the lowest of them is often not the best basin).
+const BOUNDARY_STARTS: usize = 3;
+
+/// Sweeps of the descent from each of the boundary search's starts, before the lowest is
+/// kept and descended fully. 4 gave the same fits as the full 14 on the stacked sample (8
+/// seeds), in half the time.
+const CANDIDATE_SWEEPS: u32 = 4;
+
+impl Problem {
+    /// Adds a sample set drawn on start light `origin`'s plane; returns its index.
+    fn add_set(&mut self, samples: PlaneSamples, origin: usize) -> usize {
+        self.planes.push(samples);
+        self.set_origin.push(origin);
+        self.planes.len() - 1
+    }
+
+    /// Light k reads sample set `set` from now on.
+    fn move_to_set(&self, st: &mut State, k: usize, set: usize) {
+        st.set_of[k] = set;
+        (st.coef[k], st.dev[k]) = self.coefficients(set, &st.rects[k]);
+    }
+}
+
+/// How a fit reached its optimum, for repeating it on other samples: the state its final
+/// descent started from (the start, or the split lights after their boundary search), and
+/// per extra sample set in the order they were drawn, the start light whose plane it samples
+/// (a repeat draws its own).
 struct Replay {
     start: State,
-    split: bool,
+    extra_sets: Vec<usize>,
 }
 
 /// Fits the lights from `start`: a descent, then a split of any light whose residual is
-/// structured (see [`try_split`]) and another descent. Returns the optimum and how it was
-/// reached.
+/// structured (see [`try_split`]), the second light of each split given a sample set of its
+/// own (`fresh(origin, draw)`: the `draw`-th extra set on start light `origin`'s plane) and
+/// the boundary between the two placed by [`search_boundary`], and another descent. Returns
+/// the optimum and how it was reached.
 fn optimise(
-    problem: &Problem,
+    problem: &mut Problem,
     start: &[FittedLight],
-    extents: &[Option<Rect>],
+    extents: &mut Vec<Option<Rect>>,
     sweeps: u32,
     split: bool,
+    fresh: &dyn Fn(usize, u32) -> PlaneSamples,
 ) -> (State, Replay) {
     let mut st = problem.state(
         (0..start.len()).collect(),
@@ -2028,29 +2451,47 @@ fn optimise(
             .collect(),
         start
             .iter()
-            .zip(extents)
+            .zip(extents.iter())
             .map(|(l, e)| clamp_to(l.rect(), *e))
             .collect(),
         start.iter().map(|l| l.radiance.map(f64::from)).collect(),
     );
     let mut replay = Replay {
         start: st.clone(),
-        split: false,
+        extra_sets: Vec::new(),
     };
     problem.descend(&mut st, extents, sweeps);
     if split && problem.structured(&st) {
-        let mut cut = st.clone();
         for k in 0..start.len() {
-            if let Some((trial, trial_cut)) = try_split(problem, &st, k, extents) {
-                st = trial;
-                cut = trial_cut;
+            let Some((trial, inner)) = try_split(problem, &st, k, extents) else {
+                continue;
+            };
+            st = trial;
+            let b = st.rects.len() - 1;
+            // The two lights of a split read independent samples: with one set shared, the
+            // cost's noise along their common boundary has minima far from the truth
+            // (BENCHMARKS.md, the stacked sample).
+            let origin = problem.set_origin[st.set_of[k]];
+            let samples = fresh(origin, replay.extra_sets.len() as u32 + 1);
+            extents.push(sample_extent(&samples));
+            let set = problem.add_set(samples, origin);
+            replay.extra_sets.push(origin);
+            problem.move_to_set(&mut st, b, set);
+            let starts = search_boundary(problem, &st, k, b, inner);
+            let mut best: Option<(State, f64)> = None;
+            for mut cand in starts {
+                problem.descend(&mut cand, extents, CANDIDATE_SWEEPS);
+                let c = problem.cost(&cand);
+                if best.as_ref().is_none_or(|(_, b)| c < *b) {
+                    best = Some((cand, c));
+                }
+            }
+            if let Some((cand, _)) = best {
+                st = cand;
             }
         }
-        if st.rects.len() > start.len() {
-            replay = Replay {
-                start: cut,
-                split: true,
-            };
+        if !replay.extra_sets.is_empty() {
+            replay.start = st.clone();
             problem.descend(&mut st, extents, sweeps);
         }
     }
@@ -2058,8 +2499,20 @@ fn optimise(
 }
 
 impl Problem {
-    /// The fit `replay` describes, on this problem's samples.
-    fn replay(&self, replay: &Replay, extents: &[Option<Rect>], sweeps: u32) -> State {
+    /// The fit `replay` describes, on this problem's samples (`fresh` draws its extra sets,
+    /// as in [`optimise`]).
+    fn replay(
+        &mut self,
+        replay: &Replay,
+        extents: &mut Vec<Option<Rect>>,
+        sweeps: u32,
+        fresh: &dyn Fn(usize, u32) -> PlaneSamples,
+    ) -> State {
+        for (draw, &origin) in replay.extra_sets.iter().enumerate() {
+            let samples = fresh(origin, draw as u32 + 1);
+            extents.push(sample_extent(&samples));
+            self.add_set(samples, origin);
+        }
         let from = &replay.start;
         let mut st = self.state(
             from.set_of.clone(),
@@ -2067,9 +2520,6 @@ impl Problem {
             from.rects.clone(),
             from.radiance.clone(),
         );
-        if replay.split {
-            self.descend(&mut st, extents, SPLIT_TRIAL_SWEEPS);
-        }
         self.descend(&mut st, extents, sweeps);
         st
     }
@@ -2247,11 +2697,12 @@ const FACING_REASON: &str = "it faces another light split from the same streak: 
 /// its streak's edge pixels; the facing ones were made by the cut, and the streak's edges say
 /// nothing about them. Two lights count as one above the other when their centres are
 /// further apart vertically than horizontally, each in units of the pair's summed size.
-fn facing_edges(st: &State) -> Vec<[bool; 4]> {
+fn facing_edges(problem: &Problem, st: &State) -> Vec<[bool; 4]> {
     let n = st.rects.len();
+    let origin = |k: usize| problem.set_origin[st.set_of[k]];
     let mut out = vec![[false; 4]; n];
     for (a, facing) in out.iter_mut().enumerate() {
-        for b in (0..n).filter(|&b| b != a && st.set_of[b] == st.set_of[a]) {
+        for b in (0..n).filter(|&b| b != a && origin(b) == origin(a)) {
             let (ra, rb) = (st.rects[a], st.rects[b]);
             let du = (rb.u_min + rb.u_max - ra.u_min - ra.u_max) / (ra.width() + rb.width());
             let dv = (rb.v_min + rb.v_max - ra.v_min - ra.v_max) / (ra.height() + rb.height());
@@ -2301,10 +2752,25 @@ mod tests {
     /// coefficient bias; measured well under that), the squared error must fall, and the
     /// derivative by the top edge, which is what moves the fit, far more (measured: to 0.45
     /// and 0.05-0.1 of the plain estimate's, BENCHMARKS.md).
-    #[test]
-    fn the_control_variate_keeps_the_expectation_and_cuts_the_noise() {
+    /// Table 3's photo and scene, light0 as the paper fits it, and every 8th pixel of its
+    /// fitted region: what the tests below trace samples for.
+    struct Table3Light0 {
+        scene: crate::scene_in::Scene,
+        model: ReflectionModel,
+        light: FittedLight,
+        roi: Rect,
+        pixels: Vec<u32>,
+        width: u32,
+        height: u32,
+    }
+
+    fn table3_light0() -> Table3Light0 {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        let dir = std::env::temp_dir().join(format!("streaklight-cv-{}", std::process::id()));
+        let dir = std::env::temp_dir().join(format!(
+            "streaklight-joint-{}-{:?}",
+            std::process::id(),
+            std::thread::current().id()
+        ));
         crate::samples::write_scenes(&dir).expect("sample scenes");
         let scene =
             crate::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
@@ -2330,31 +2796,133 @@ mod tests {
         };
         let paper = super::super::fit_paper(&scene, &photo, &water, &observations, &options)
             .expect("paper fit");
-        let light = &paper.lights[0];
-        let planes = [&light.plane];
-        let roi = [region_of_interest(&light.rect())];
+        let light = paper.lights[0].clone();
+        let roi = region_of_interest(&light.rect());
         let used: Vec<&StreakObservation> = observations.iter().collect();
         let pixels: Vec<u32> = region(
-            &scene, &model, &planes, &roi, &photo, &water, &used, 6, true,
+            &scene,
+            &model,
+            &[&light.plane],
+            &[roi],
+            &photo,
+            &water,
+            &used,
+            6,
+            true,
         )
         .into_iter()
         .step_by(8)
         .collect();
-        let trace = |samples: u32, seed: u64, cv: bool| {
+        Table3Light0 {
+            scene,
+            model,
+            light,
+            roi,
+            pixels,
+            width: photo.width,
+            height: photo.height,
+        }
+    }
+
+    impl Table3Light0 {
+        fn trace(&self, samples: u32, seed: u64, draw: u32, cv: bool) -> (Vec<PlaneSamples>, u32) {
             trace_samples(
-                &scene,
-                &model,
-                &planes,
-                &roi,
-                &pixels,
-                photo.width,
-                photo.height,
+                &self.scene,
+                &self.model,
+                &[&self.light.plane],
+                &[self.roi],
+                &self.pixels,
+                self.width,
+                self.height,
                 samples,
                 seed,
                 0,
+                draw,
                 cv,
             )
+        }
+    }
+
+    #[test]
+    fn edge_coefficients_match_the_coefficient_at_every_grid_point() {
+        let t = table3_light0();
+        let (planes, n) = t.trace(72, 1, 0, true);
+        let inv = 1.0 / n as f32;
+        let rect = t.light.rect();
+        let grid = 17;
+        let (mut coef, mut dev) = (vec![0f32; grid], vec![0f32; grid]);
+        let mut compared = 0;
+        for side in EdgeSide::ALL {
+            // Across the edge, from 0.4 m inside to 0.4 m outside the rectangle.
+            let (lo, step) = (rect.edge(side) - 0.4, 0.05);
+            let mut ramps = EdgeRamps::new(lo, step, grid);
+            for i in 0..t.pixels.len() {
+                planes[0].edge_coefficients(
+                    i, &rect, side, lo, step, inv, &mut ramps, &mut coef, &mut dev,
+                );
+                for j in 0..grid {
+                    let moved = rect.with_edge(side, lo + j as f32 * step);
+                    let (c, d) = planes[0].coefficient(i, &moved, inv);
+                    let tolerance = 1e-6 + 1e-4 * c.abs().max(d.abs());
+                    assert!(
+                        (coef[j] - c).abs() <= tolerance && (dev[j] - d).abs() <= tolerance,
+                        "{side:?} pixel {i} point {j}: ({}, {}) against ({c}, {d})",
+                        coef[j],
+                        dev[j]
+                    );
+                    compared += (c != 0.0) as usize;
+                }
+            }
+        }
+        assert!(
+            compared > 1000,
+            "only {compared} nonzero coefficients compared"
+        );
+    }
+
+    #[test]
+    fn extra_sample_sets_are_independent_draws_of_the_same_coefficients() {
+        // A split light's own set (draw 1) against the set every light reads (draw 0): other
+        // samples, the same expectation.
+        let t = table3_light0();
+        let rect = t.light.rect();
+        let sums = |draw: u32| -> (Vec<Vec2>, Vec<f64>) {
+            let (planes, n) = t.trace(72, 1, draw, true);
+            let inv = 1.0 / n as f32;
+            let c = (0..t.pixels.len())
+                .map(|i| planes[0].coefficient(i, &rect, inv).0 as f64)
+                .collect();
+            (planes[0].points.clone(), c)
         };
+        let (points0, c0) = sums(0);
+        let (points1, c1) = sums(1);
+        let shared = points0.iter().zip(&points1).filter(|(a, b)| a == b).count();
+        assert!(
+            shared * 100 < points0.len(),
+            "{shared} of {} points alike",
+            points0.len()
+        );
+        let total: f64 = c0.iter().sum();
+        let diff: f64 = c0.iter().zip(&c1).map(|(a, b)| a - b).sum();
+        // The two sums differ by their samples' noise alone: per pixel the half-differences
+        // measure it; summed over the pixels the relative difference is far under 1 %.
+        assert!(total > 0.0);
+        assert!(
+            (diff / total).abs() < 0.005,
+            "sums {total} and {}",
+            total - diff
+        );
+        // Not the same numbers: the pixels' values differ.
+        let differing = c0.iter().zip(&c1).filter(|(a, b)| a != b).count();
+        assert!(differing * 2 > c0.iter().filter(|c| **c != 0.0).count());
+    }
+
+    #[test]
+    fn the_control_variate_keeps_the_expectation_and_cuts_the_noise() {
+        let t = table3_light0();
+        let light = &t.light;
+        let pixels = &t.pixels;
+        let trace = |samples: u32, seed: u64, cv: bool| t.trace(samples, seed, 0, cv);
         let rect = light.rect();
         let moved = rect.with_edge(EdgeSide::Top, rect.v_max + 0.02);
         // Per pixel: the coefficient and its change as the top edge moves up 2 cm.
