@@ -464,6 +464,8 @@ fn lobe_strata(samples: u32) -> u32 {
 /// inside its region of interest but hits something else first (or nothing: the wall ends)
 /// is stored too, with the lobe's weight 0: the Gaussian it subtracts must be subtracted
 /// wherever the Gaussian is, or the estimate would see light through the obstacle.
+/// `repeat` and `draw` select independent random streams: `draw` 0 is the set every start
+/// light reads, `draw` 1, 2, ... the sets of lights that splits added (one plane each).
 #[allow(clippy::too_many_arguments)]
 fn trace_samples(
     scene: &Scene,
