@@ -190,6 +190,33 @@ struct PlaneSamples {
     min_size: Vec2,
 }
 
+/// A rectangle seen from one of its edges as that edge moves: whether the edge is a left or
+/// right one (it moves along u), whether it is the lower of its pair, where the opposite
+/// edge is, and the rectangle's extent along the edge.
+struct EdgeFrame {
+    along_u: bool,
+    min_edge: bool,
+    opposite: f32,
+    across: (f32, f32),
+}
+
+impl EdgeFrame {
+    fn new(rect: &Rect, side: EdgeSide) -> Self {
+        let (min_edge, opposite, across) = match side {
+            EdgeSide::Left => (true, rect.u_max, (rect.v_min, rect.v_max)),
+            EdgeSide::Right => (false, rect.u_min, (rect.v_min, rect.v_max)),
+            EdgeSide::Bottom => (true, rect.v_max, (rect.u_min, rect.u_max)),
+            EdgeSide::Top => (false, rect.v_min, (rect.u_min, rect.u_max)),
+        };
+        EdgeFrame {
+            along_u: matches!(side, EdgeSide::Left | EdgeSide::Right),
+            min_edge,
+            opposite,
+            across,
+        }
+    }
+}
+
 impl PlaneSamples {
     fn range(&self, i: usize) -> std::ops::Range<usize> {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
@@ -234,32 +261,8 @@ impl PlaneSamples {
         coef: &mut [f32],
         dev: &mut [f32],
     ) {
-        let along_u = matches!(side, EdgeSide::Left | EdgeSide::Right);
-        let (min_edge, opp, o_lo, o_hi) = match side {
-            EdgeSide::Left => (true, rect.u_max, rect.v_min, rect.v_max),
-            EdgeSide::Right => (false, rect.u_min, rect.v_min, rect.v_max),
-            EdgeSide::Bottom => (true, rect.v_max, rect.u_min, rect.u_max),
-            EdgeSide::Top => (false, rect.v_min, rect.u_min, rect.u_max),
-        };
         ramps.clear(coef.len());
-        let r = self.range(i);
-        for (((p, h), &w), &half) in self.points[r.clone()]
-            .iter()
-            .zip(&self.cells[r.clone()])
-            .zip(&self.weights[r.clone()])
-            .zip(&self.halves[r])
-        {
-            let (x, hx, y, hy) = if along_u {
-                (p.x, h.x, p.y, h.y)
-            } else {
-                (p.y, h.y, p.x, h.x)
-            };
-            let across = kernel_coverage(y, hy, o_lo, o_hi);
-            if across != 0.0 {
-                let weight = (w * across) as f64;
-                ramps.add_cell(min_edge, x, hx, opp, weight, weight * half as f64);
-            }
-        }
+        self.add_to_ramps(self.range(i), &EdgeFrame::new(rect, side), ramps);
         ramps.values(coef, dev);
         let g = &self.gauss[i];
         for (j, (c, d)) in coef.iter_mut().zip(dev.iter_mut()).enumerate() {
@@ -271,6 +274,43 @@ impl PlaneSamples {
             *c = *c * inv_samples + mass;
             *d *= inv_samples;
         }
+    }
+
+    /// Adds the samples `range` to `ramps` as functions of the edge `frame` describes (each
+    /// sample's kernel, its share across the edge's axis inside the rectangle counted);
+    /// returns whether any counts anywhere on the ramps' grid.
+    fn add_to_ramps(
+        &self,
+        range: std::ops::Range<usize>,
+        frame: &EdgeFrame,
+        ramps: &mut EdgeRamps,
+    ) -> bool {
+        let mut any = false;
+        for (((p, h), &w), &half) in self.points[range.clone()]
+            .iter()
+            .zip(&self.cells[range.clone()])
+            .zip(&self.weights[range.clone()])
+            .zip(&self.halves[range])
+        {
+            let (x, hx, y, hy) = if frame.along_u {
+                (p.x, h.x, p.y, h.y)
+            } else {
+                (p.y, h.y, p.x, h.x)
+            };
+            let across = kernel_coverage(y, hy, frame.across.0, frame.across.1);
+            if across != 0.0 {
+                let weight = (w * across) as f64;
+                any |= ramps.add_cell(
+                    frame.min_edge,
+                    x,
+                    hx,
+                    frame.opposite,
+                    weight,
+                    weight * half as f64,
+                );
+            }
+        }
+        any
     }
 }
 
@@ -1148,13 +1188,9 @@ impl Problem {
         let mut clipped_rows: Vec<(usize, Vec<f32>)> = Vec::new();
         let mut flat = FlatSums::default();
         let hi = lo + step * (grid - 1) as f32;
-        let along_u = matches!(side, EdgeSide::Left | EdgeSide::Right);
-        let (min_edge, (opp, o_lo, o_hi)) = match side {
-            EdgeSide::Left => (true, (rect.u_max, rect.v_min, rect.v_max)),
-            EdgeSide::Right => (false, (rect.u_min, rect.v_min, rect.v_max)),
-            EdgeSide::Bottom => (true, (rect.v_max, rect.u_min, rect.u_max)),
-            EdgeSide::Top => (false, (rect.v_min, rect.u_min, rect.u_max)),
-        };
+        let frame = EdgeFrame::new(&rect, side);
+        let (along_u, min_edge, opp) = (frame.along_u, frame.min_edge, frame.opposite);
+        let (o_lo, o_hi) = frame.across;
         for &i in chunk {
             let r = plane.range(i);
             let g = plane.gauss[i];
@@ -1213,25 +1249,8 @@ impl Problem {
             } else {
                 0..0
             };
-            for (((p, h), &w), &half) in plane.points[r.clone()]
-                .iter()
-                .zip(&plane.cells[r.clone()])
-                .zip(&plane.weights[r.clone()])
-                .zip(&plane.halves[r])
-            {
-                let (x, hx, y, hy) = if along_u {
-                    (p.x, h.x, p.y, h.y)
-                } else {
-                    (p.y, h.y, p.x, h.x)
-                };
-                let across = kernel_coverage(y, hy, o_lo, o_hi);
-                if across == 0.0 {
-                    continue;
-                }
-                let weight = (w * across) as f64;
-                if ramps.add_cell(min_edge, x, hx, opp, weight, weight * half as f64) {
-                    any = true;
-                }
+            if plane.add_to_ramps(r, &frame, &mut ramps) {
+                any = true;
             }
             if !any && !gauss_varies && !self.clipped[i] {
                 same_everywhere(g.mass_inside(&rect) as f64, 0.0, &mut flat);
@@ -1739,21 +1758,24 @@ pub fn fit_joint(
         options.margin,
         options.checkerboard,
     );
-    let problem_for = |repeat: u32| {
-        let (stored, per_pixel_samples) = trace_samples(
+    let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
+        trace_samples(
             scene,
             &options.model,
-            &planes,
-            &roi,
+            planes,
+            roi,
             &pixels,
             photo.width,
             photo.height,
             options.samples,
             options.seed,
             repeat,
-            0,
+            draw,
             options.control_variate,
-        );
+        )
+    };
+    let problem_for = |repeat: u32| {
+        let (stored, per_pixel_samples) = trace(&planes, &roi, repeat, 0);
         Problem {
             width: photo.width,
             pixel_ids: pixels.clone(),
@@ -1770,20 +1792,7 @@ pub fn fit_joint(
     // independent of every other set.
     let fresh_set = |repeat: u32, origin: usize, draw: u32| {
         let t = Instant::now();
-        let (mut stored, _) = trace_samples(
-            scene,
-            &options.model,
-            &[planes[origin]],
-            &[roi[origin]],
-            &pixels,
-            photo.width,
-            photo.height,
-            options.samples,
-            options.seed,
-            repeat,
-            draw,
-            options.control_variate,
-        );
+        let (mut stored, _) = trace(&[planes[origin]], &[roi[origin]], repeat, draw);
         fresh_seconds.set(fresh_seconds.get() + t.elapsed().as_secs_f64());
         // One plane in, one set out.
         stored.swap_remove(0)

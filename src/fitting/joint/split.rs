@@ -86,12 +86,12 @@ const OUTER_STEP: f32 = 0.015;
 /// the two outer edges across that axis at a few positions around where they are, both
 /// radiances re-solved for each combination. The lowest [`BOUNDARY_STARTS`] local minima of
 /// that cost are each refined by the same search on a finer grid around them; returns the
-/// refined states, lowest coarse minimum first. The split's coarse descent from the half cut cannot do this: the
-/// boundary hardly moves from where the cut put it (moving one inner edge alone opens a gap
-/// or an overlap), the outer edges have settled to match it, and the half cut lies in
-/// another basin than the truth's (BENCHMARKS.md, the stacked sample). The other lights stay
-/// where they are; clipped pixels are left out of the search (the descent after it counts
-/// them as lower bounds).
+/// refined states, lowest coarse minimum first. The split's coarse descent from the half cut
+/// cannot do this: the boundary hardly moves from where the cut put it (moving one inner
+/// edge alone opens a gap or an overlap), the outer edges have settled to match it, and the
+/// half cut lies in another basin than the truth's (BENCHMARKS.md, the stacked sample). The
+/// other lights stay where they are; clipped pixels are left out of the search (the descent
+/// after it counts them as lower bounds).
 pub(super) fn search_boundary(
     problem: &Problem,
     st: &State,
