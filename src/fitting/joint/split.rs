@@ -131,10 +131,10 @@ const FINE_GRID: usize = 13;
 
 /// The local minima of the boundary search's cost (see [`search_boundary`]), lowest first:
 /// the two rectangles, the cost, and the half-window a finer search around the minimum
-/// should cover (one and a half grid steps of the inner edges). The
-/// inner edges range over their whole span (`window` None) or over +-`window` about their
-/// current positions, on `grid` points each; the outer edges over [`OUTER_GRID`] positions
-/// `outer_step` of the span apart.
+/// should cover (one and a half grid steps of the inner edges). The inner edges range over
+/// their whole span (`window` None) or over +-`window` about their current positions, on
+/// `grid` points each; the outer edges over [`OUTER_GRID`] positions `outer_step` of the
+/// span apart.
 #[allow(clippy::too_many_arguments)]
 fn boundary_minima(
     problem: &Problem,
