@@ -401,7 +401,7 @@ fn shared_streak_warnings(lights: &[LightReport]) -> Vec<String> {
             format!(
                 "{noun} {} {verb} {} lights ({}), whose reflections overlap: the photo tells them \
                  apart only weakly where they meet, so their facing edges and radiances may be off \
-                 by several percent (up to 20 % on the bundled stacked sample); their reported \
+                 by several percent (up to about 25 % on the bundled stacked sample); their reported \
                  uncertainties are correspondingly wide",
                 ids.join(", "),
                 names.len(),
