@@ -1824,9 +1824,14 @@ pub fn fit_joint(
         footprint_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let mut extents: Vec<Option<Rect>> = again.planes.iter().map(sample_extent).collect();
-        let st = again.replay(&replay, &mut extents, options.sweeps, &|origin, draw| {
-            fresh_set(repeat, origin, draw)
-        });
+        let extra_origins = &problem.set_origin[start.len()..];
+        let st = again.replay(
+            &replay,
+            extra_origins,
+            &mut extents,
+            options.sweeps,
+            &|origin, draw| fresh_set(repeat, origin, draw),
+        );
         repeats.push((st.rects, st.radiance));
         optimise_seconds += t.elapsed().as_secs_f64();
     }
@@ -2050,20 +2055,13 @@ impl Problem {
 /// tried (see [`Problem::structured`]).
 const SPLIT_STRUCTURE_RATIO: f64 = 3.0;
 
-/// How a fit reached its optimum, for repeating it on other samples: the state its final
-/// descent started from (the start, or the split lights after their boundary search), and
-/// per extra sample set in the order they were drawn, the start light whose plane it samples
-/// (a repeat draws its own).
-struct Replay {
-    start: State,
-    extra_sets: Vec<usize>,
-}
-
 /// Fits the lights from `start`: a descent, then a split of any light whose residual is
 /// structured (see [`try_split`]), the second light of each split given a sample set of its
 /// own (`fresh(origin, draw)`: the `draw`-th extra set on start light `origin`'s plane) and
 /// the boundary between the two placed by [`search_boundary`], and another descent. Returns
-/// the optimum and how it was reached.
+/// the optimum and the state its last descent started from (the start, or the split lights
+/// after their boundary search): a repeat on other samples starts there (see
+/// [`Problem::replay`]).
 fn optimise(
     problem: &mut Problem,
     start: &[FittedLight],
@@ -2071,7 +2069,7 @@ fn optimise(
     sweeps: u32,
     split: bool,
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
-) -> (State, Replay) {
+) -> (State, State) {
     let mut st = problem.state(
         (0..start.len()).collect(),
         start
@@ -2089,10 +2087,7 @@ fn optimise(
             .collect(),
         start.iter().map(|l| l.radiance.map(f64::from)).collect(),
     );
-    let mut replay = Replay {
-        start: st.clone(),
-        extra_sets: Vec::new(),
-    };
+    let mut replay = st.clone();
     problem.descend(&mut st, extents, sweeps);
     if split && problem.structured(&st) {
         for k in 0..start.len() {
@@ -2105,10 +2100,10 @@ fn optimise(
             // cost's noise along their common boundary has minima far from the truth
             // (BENCHMARKS.md, the stacked sample).
             let origin = problem.set_origin[st.set_of[k]];
-            let samples = fresh(origin, replay.extra_sets.len() as u32 + 1);
+            let draw = (problem.planes.len() - start.len()) as u32 + 1;
+            let samples = fresh(origin, draw);
             extents.push(sample_extent(&samples));
             let set = problem.add_set(samples, origin);
-            replay.extra_sets.push(origin);
             problem.move_to_set(&mut st, b, set);
             let starts = search_boundary(problem, &st, k, b, inner);
             let mut best: Option<(State, f64)> = None;
@@ -2123,8 +2118,8 @@ fn optimise(
                 st = cand;
             }
         }
-        if !replay.extra_sets.is_empty() {
-            replay.start = st.clone();
+        if problem.planes.len() > start.len() {
+            replay = st.clone();
             problem.descend(&mut st, extents, sweeps);
         }
     }
@@ -2132,21 +2127,23 @@ fn optimise(
 }
 
 impl Problem {
-    /// The fit `replay` describes, on this problem's samples (`fresh` draws its extra sets,
-    /// as in [`optimise`]).
+    /// The fit that `optimise` made, repeated on this problem's samples: from `from`, the
+    /// state its last descent started from, whose extra sample sets (one per light a split
+    /// added, on start light `extra_origins[j]`'s plane) `fresh` draws anew, as in
+    /// [`optimise`].
     fn replay(
         &mut self,
-        replay: &Replay,
+        from: &State,
+        extra_origins: &[usize],
         extents: &mut Vec<Option<Rect>>,
         sweeps: u32,
         fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     ) -> State {
-        for (draw, &origin) in replay.extra_sets.iter().enumerate() {
+        for (draw, &origin) in extra_origins.iter().enumerate() {
             let samples = fresh(origin, draw as u32 + 1);
             extents.push(sample_extent(&samples));
             self.add_set(samples, origin);
         }
-        let from = &replay.start;
         let mut st = self.state(
             from.set_of.clone(),
             from.pinned.clone(),

@@ -99,25 +99,35 @@ pub(super) fn search_boundary(
     b: usize,
     inner: [EdgeSide; 2],
 ) -> Vec<State> {
-    let coarse = boundary_minima(problem, st, a, b, inner, None, BOUNDARY_GRID, OUTER_STEP);
+    let here = [st.rects[a], st.rects[b]];
+    let coarse = boundary_minima(
+        problem,
+        st,
+        a,
+        b,
+        inner,
+        here,
+        None,
+        BOUNDARY_GRID,
+        OUTER_STEP,
+    );
     coarse
         .iter()
         .take(BOUNDARY_STARTS)
         .filter_map(|&(rects, _, window)| {
-            let mut cand = st.clone();
-            problem.set_rect(&mut cand, a, rects[0]);
-            problem.set_rect(&mut cand, b, rects[1]);
             let fine = boundary_minima(
                 problem,
-                &cand,
+                st,
                 a,
                 b,
                 inner,
+                rects,
                 Some(window),
                 FINE_GRID,
                 OUTER_STEP / 2.0,
             );
             let &(rects, _, _) = fine.first()?;
+            let mut cand = st.clone();
             problem.set_rect(&mut cand, a, rects[0]);
             problem.set_rect(&mut cand, b, rects[1]);
             problem.solve_radiance(&mut cand);
@@ -134,7 +144,8 @@ const FINE_GRID: usize = 13;
 /// should cover (one and a half grid steps of the inner edges). The inner edges range over
 /// their whole span (`window` None) or over +-`window` about their current positions, on
 /// `grid` points each; the outer edges over [`OUTER_GRID`] positions `outer_step` of the
-/// span apart.
+/// span apart. The search is centred on `around` (a's and b's rectangles; the other lights
+/// are read from `st`).
 #[allow(clippy::too_many_arguments)]
 fn boundary_minima(
     problem: &Problem,
@@ -142,11 +153,12 @@ fn boundary_minima(
     a: usize,
     b: usize,
     inner: [EdgeSide; 2],
+    around: [Rect; 2],
     window: Option<f32>,
     grid: usize,
     outer_step: f32,
 ) -> Vec<([Rect; 2], f64, f32)> {
-    let (ra, rb) = (st.rects[a], st.rects[b]);
+    let [ra, rb] = around;
     let outer = [inner[1], inner[0]];
     let (set_a, set_b) = (st.set_of[a], st.set_of[b]);
     let vertical = inner[0] == EdgeSide::Top;
