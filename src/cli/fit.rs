@@ -54,8 +54,9 @@ pub struct Args {
     pub repeats: u32,
     /// Lobe samples per pixel of the joint fit, rounded to 8 b^2 (8, 32, 72, 128, 200, 288,
     /// ...; default 72, or 128 for the final fit of --gloss auto): the time grows with them,
-    /// the fit's own noise falls (Table 3's first light: worst edge 0.27 % rms at 72, 0.06 % at
-    /// 1152, four times slower).
+    /// the fit's own noise falls (Table 3's second light, seen only in part: top 0.56 % rms
+    /// at 72, 0.26 % at 288, about four times slower; beyond that the photo's own noise is
+    /// what is left).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub joint_samples: Option<u32>,
     /// Succeed and write the scene unchanged when no light is found.
