@@ -92,6 +92,9 @@ pub struct ConvertOptions {
     /// [`fitting::gloss::SEARCH_SAMPLES`]). More cost proportionally more time and leave less of
     /// the fit's own noise in the result.
     pub joint_samples: Option<u32>,
+    /// Fit every pixel of the joint fit's region, not a checkerboard half
+    /// ([`JointOptions::checkerboard`] off): about twice the time, less noise.
+    pub all_pixels: bool,
     /// Told a line as each stage of the run starts (None: silent). The CLI prints them, so a
     /// long fit (`--gloss auto`, `--repeats`) shows where it is.
     pub progress: Option<fn(&str)>,
@@ -124,6 +127,7 @@ impl ConvertOptions {
             estimate_gloss: false,
             repeats: 1,
             joint_samples: None,
+            all_pixels: false,
             progress: None,
         }
     }
@@ -488,6 +492,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             &GlossSearch {
                 final_repeats: options.repeats,
                 final_samples: joint_samples,
+                final_checkerboard: !options.all_pixels,
                 progress: options.progress,
                 ..GlossSearch::starting_from(fit_options)
             },
@@ -533,6 +538,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
                 &JointOptions {
                     repeats: options.repeats,
                     samples: joint_samples,
+                    checkerboard: !options.all_pixels,
                     progress: options.progress,
                     ..JointOptions::new(fit_options.model, options.seed)
                 },
@@ -671,6 +677,11 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             joint_samples: match (options.method, options.estimate_gloss) {
                 (Method::Paper, false) => None,
                 _ => Some(joint::effective_samples(joint_samples)),
+            },
+            joint_pixels: match (options.method, options.estimate_gloss) {
+                (Method::Paper, false) => None,
+                _ if options.all_pixels => Some("all".into()),
+                _ => Some("checkerboard".into()),
             },
             exposure: options.exposure,
             nits_scale: options.load.nits_scale,

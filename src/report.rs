@@ -57,6 +57,9 @@ pub struct Settings {
     /// Lobe samples per pixel of the (final) joint fit, as taken (`None` for the paper
     /// method).
     pub joint_samples: Option<u32>,
+    /// Which pixels of its region the (final) joint fit read: "checkerboard" (every second
+    /// one, the default) or "all" (`--all-pixels`); `None` for the paper method.
+    pub joint_pixels: Option<String>,
     /// Divisor applied to the photo's linear values.
     pub exposure: f32,
     /// Intensity units per unit of radiance in the written lights.

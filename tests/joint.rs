@@ -357,6 +357,10 @@ fn joint_method_through_the_converter() {
         outcome.report.settings.joint_samples,
         Some(streaklight::fitting::joint::DEFAULT_JOINT_SAMPLES)
     );
+    assert_eq!(
+        outcome.report.settings.joint_pixels.as_deref(),
+        Some("checkerboard")
+    );
     assert_eq!(outcome.report.lights.len(), 1);
     let light = &outcome.report.lights[0];
     let truth = samples::table1_light();
@@ -459,4 +463,89 @@ fn stacked_lights_apart_never_become_a_sliver() {
             l.radiance
         );
     }
+}
+
+/// `--all-pixels`: the joint fit reads every pixel of its region instead of a checkerboard
+/// half. On Table 1 the region then holds twice the pixels (the checkerboard keeps every
+/// second one, so within a few pixels of its border), the lights stay within
+/// [`LIGHT0_BOUND`], and the report says which pixels were read.
+#[test]
+fn all_pixels_reads_the_whole_region() {
+    use streaklight::fitting::joint::{fit_joint, JointOptions};
+    use streaklight::fitting::{fit_paper, FitOptions};
+    use streaklight::optics::ReflectionModel;
+    let dir = scenes();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene =
+        streaklight::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
+    let photo =
+        streaklight::photo_in::load(&root.join("samples/table1.png"), samples::PHOTO_EXPOSURE)
+            .expect("photo");
+    let water = streaklight::water_mask::water_mask(&scene, photo.width, photo.height);
+    let streaks = streaklight::streaks::extract_streaks(&photo, &water, &Default::default())
+        .expect("streaks");
+    let observations: Vec<_> = streaks
+        .streaks
+        .iter()
+        .map(|s| streaklight::convert::observation(s, photo.width))
+        .collect();
+    let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
+    let paper = fit_paper(
+        &scene,
+        &photo,
+        &water,
+        &observations,
+        &FitOptions {
+            samples: 256,
+            seed: 1,
+            model,
+        },
+    )
+    .expect("paper fit");
+    let fit = |checkerboard: bool| {
+        fit_joint(
+            &scene,
+            &photo,
+            &water,
+            &observations,
+            &paper.lights,
+            &JointOptions {
+                checkerboard,
+                ..JointOptions::new(model, 1)
+            },
+        )
+        .expect("joint fit")
+    };
+    let (half, all) = (fit(true), fit(false));
+    let ratio = all.pixels as f64 / half.pixels as f64;
+    assert!(
+        (ratio - 2.0).abs() < 0.01,
+        "{} pixels against {}",
+        all.pixels,
+        half.pixels
+    );
+
+    let report = convert(&ConvertOptions {
+        exposure: samples::PHOTO_EXPOSURE,
+        all_pixels: true,
+        ..ConvertOptions::new(
+            dir.join("scene.gltf"),
+            root.join("samples/table1.png"),
+            dir.join("table1-all-pixels.gltf"),
+        )
+    })
+    .expect("fit")
+    .report;
+    assert_eq!(report.settings.joint_pixels.as_deref(), Some("all"));
+    assert_eq!(report.lights.len(), 1);
+    let (e, r) = errors(&report.lights[0], &samples::table1_light());
+    eprintln!(
+        "table1, all pixels: edges % {:?} radiance {:.3} %",
+        percent(e),
+        100.0 * r
+    );
+    assert!(
+        e.iter().all(|x| x.abs() < LIGHT0_BOUND) && r < LIGHT0_BOUND,
+        "{e:?} {r}"
+    );
 }

@@ -59,6 +59,12 @@ pub struct Args {
     /// what is left).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub joint_samples: Option<u32>,
+    /// Fit every water pixel near the streaks instead of every second one (a checkerboard):
+    /// about twice the joint fit's time, and less of both the samples' and the photo's noise
+    /// (on the stacked sample, where two lights share a streak, the lower light's top 5.2 %
+    /// rms off instead of 8.8 %; more samples per pixel cannot average the photo's noise).
+    #[arg(long)]
+    pub all_pixels: bool,
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]
     pub allow_empty: bool,
@@ -97,6 +103,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         estimate_gloss: matches!(args.gloss, Some(GlossArg::Auto)),
         repeats: args.repeats,
         joint_samples: args.joint_samples,
+        all_pixels: args.all_pixels,
         progress: Some(|line| eprintln!("{line}")),
     };
     let outcome = convert(&options)?;

@@ -121,6 +121,9 @@ pub struct GlossSearch {
     /// Independent final fits at the estimate whose mean is the result
     /// ([`JointOptions::repeats`]).
     pub final_repeats: u32,
+    /// Whether the final fit reads a checkerboard half of its region's pixels
+    /// ([`JointOptions::checkerboard`]; the search always does).
+    pub final_checkerboard: bool,
     /// Told a line as each joint fit of the search, and the final fit (and its repeats),
     /// starts (None: silent): the search takes tens of seconds.
     pub progress: Option<fn(&str)>,
@@ -151,6 +154,7 @@ impl GlossSearch {
             search_sweeps: 6,
             final_samples: SEARCH_SAMPLES,
             final_repeats: 1,
+            final_checkerboard: true,
             progress: None,
         }
     }
@@ -352,6 +356,7 @@ pub fn estimate_gloss(
         &JointOptions {
             samples: options.final_samples,
             repeats: options.final_repeats,
+            checkerboard: options.final_checkerboard,
             progress: options.progress,
             ..JointOptions::new(model_at(options, gloss), options.fit.seed)
         },
