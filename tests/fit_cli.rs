@@ -157,14 +157,15 @@ fn good_input_fits_a_light_and_validates() {
             "no progress line {stage:?}: {stderr}"
         );
     }
-    // Also as .glb, with two repeats: the second announced, the count in the report.
+    // Also as .glb, with two repeats (the second announced, the count in the report) and
+    // every pixel of the region read.
     let glb = dir.join("out.glb");
     let (ok, stderr) = run(&fit_args(
         &scene,
         &photo,
         &glb,
         &report,
-        &["--repeats", "2", "--joint-samples", "33"],
+        &["--repeats", "2", "--joint-samples", "33", "--all-pixels"],
     ));
     assert!(ok, "{stderr}");
     assert!(stderr.contains("joint fit: repeat 2 of 2"), "{stderr}");
@@ -172,6 +173,7 @@ fn good_input_fits_a_light_and_validates() {
     assert_eq!(r["settings"]["repeats"], 2);
     // 33 asked, rounded to two halves of 2 x 2 camera rays times 2 x 2 lobe samples.
     assert_eq!(r["settings"]["joint_samples"], 32);
+    assert_eq!(r["settings"]["joint_pixels"], "all");
     gltf_check::assert_validator_clean(&glb);
 }
 
