@@ -131,6 +131,24 @@ fn main() {
             truth: "(-2, 3, 0), 3 x 1.4, L 14",
             paper: "-",
         },
+        Case {
+            name: "stacked e=1000, lower light",
+            scene: "scene.gltf",
+            photo: "stacked1000.png",
+            gloss: Some(1000.0),
+            centre: (-0.5, 1.7),
+            truth: "(-2, 1.2, 0), 3 x 1, L 16",
+            paper: "-",
+        },
+        Case {
+            name: "stacked e=1000, upper light",
+            scene: "scene.gltf",
+            photo: "stacked1000.png",
+            gloss: Some(1000.0),
+            centre: (-0.5, 3.7),
+            truth: "(-2, 3, 0), 3 x 1.4, L 14",
+            paper: "-",
+        },
     ];
     println!(
         "| case | truth | paper | method | streaklight | unconstrained edges | fit time (s) |"

@@ -7,8 +7,8 @@
 //! `cargo bench --bench spread` runs 8 seeds of Table 3 and the stacked sample with 1 and 4
 //! repeats (about 8 minutes on 2 cores). Environment: `SPREAD_SEEDS` (count), `SPREAD_REPEATS`
 //! (comma-separated, e.g. "1,4"), `SPREAD_CASES` (comma-separated photo names, e.g.
-//! "table1.png,table3.png,stacked.png"), `SPREAD_JOINT_SAMPLES` (`--joint-samples`; unset: the
-//! default), `SPREAD_RENDER_SPP` (fit a fresh render of each case's truth scene with this many
+//! "table1.png,table3.png,stacked.png,stacked1000.png"), `SPREAD_JOINT_SAMPLES` (`--joint-samples`; unset: the
+//! default), `SPREAD_ALL_PIXELS` ("1": `--all-pixels`), `SPREAD_RENDER_SPP` (fit a fresh render of each case's truth scene with this many
 //! camera rays per pixel instead of the committed 256-spp photo: a photo with less of its own
 //! noise), `SPREAD_RENDER_CACHE` (a directory: such renders are kept there and reused by later
 //! runs, which saves minutes per case; empty it after changing the renderer).
@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use streaklight::convert::{convert, ConvertOptions, Method};
 use streaklight::report::LightReport;
 use streaklight::samples::{self, SampleLight};
+use streaklight::scene_in::LoadOptions;
 
 /// Per light: errors (left, right, bottom, top in % of the size, radiance in % of the truth's
 /// largest channel) and the same in sigmas (`None` where no uncertainty was reported).
@@ -51,13 +52,15 @@ fn measure(light: &LightReport, truth: &SampleLight) -> Measure {
     (errors.map(|e| 100.0 * e), sigmas)
 }
 
-/// The truths of a committed sample photo.
-fn truths(photo: &str) -> Vec<SampleLight> {
-    match photo {
-        "table1.png" => vec![samples::table1_light()],
-        "table3.png" => samples::table3_lights(),
-        "stacked.png" => samples::stacked_lights(),
-        other => panic!("no truth for {other}: use table1.png, table3.png or stacked.png"),
+/// The truths of a committed sample photo, and its water's gloss where it is not the
+/// default scene's (`scene.gltf`'s material says e = 500; the fit is told the others).
+fn truths(photo: &str) -> (Vec<SampleLight>, Option<f32>) {
+    match samples::by_photo(photo) {
+        Some(spec) if !spec.lights.is_empty() => {
+            let gloss = (spec.gloss != samples::DEFAULT_GLOSS).then_some(spec.gloss as f32);
+            (spec.lights, gloss)
+        }
+        _ => panic!("no truth for {photo}: use a sample photo of lights, e.g. table3.png"),
     }
 }
 
@@ -91,21 +94,27 @@ fn main() {
         s.parse()
             .expect("SPREAD_JOINT_SAMPLES: a count such as 288")
     });
+    let all_pixels = std::env::var("SPREAD_ALL_PIXELS").is_ok_and(|v| v == "1");
     let cache = std::env::var_os("SPREAD_RENDER_CACHE").map(PathBuf::from);
     let dir = std::env::temp_dir().join(format!("streaklight-spread-{}", std::process::id()));
     samples::write_scenes(&dir).expect("writing the sample scenes");
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     println!(
-        "seeds 1..={seeds}; joint samples {}; photos {}; errors in % of the size (edges) and of \
-         the radiance",
+        "seeds 1..={seeds}; joint samples {}; {}; photos {}; errors in % of the size (edges) \
+         and of the radiance",
         joint_samples.map_or("default".into(), |n| n.to_string()),
+        if all_pixels {
+            "all pixels"
+        } else {
+            "checkerboard"
+        },
         render_spp.map_or("committed".into(), |n| format!("rendered at {n} spp"))
     );
     println!();
-    println!("| photo | repeats | light | rms error L, R, B, T; rad | mean error | rms sigmas | largest sigma | s per fit |");
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("| photo | repeats | light | rms error L, R, B, T; rad | mean error | largest error | rms sigmas | largest sigma | s per fit |");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for photo in &cases {
-        let truth = truths(photo);
+        let (truth, gloss) = truths(photo);
         let photo_path = match render_spp {
             None => root.join("samples").join(photo),
             Some(spp) => rendered(&dir, photo, spp, cache.as_deref()),
@@ -115,7 +124,17 @@ fn main() {
             let mut seconds = 0.0;
             for seed in 1..=seeds {
                 let t = std::time::Instant::now();
-                let lights = fit(&dir, &photo_path, seed, r, joint_samples);
+                let lights = fit(
+                    &dir,
+                    &photo_path,
+                    FitSettings {
+                        seed,
+                        repeats: r,
+                        joint_samples,
+                        all_pixels,
+                        gloss,
+                    },
+                );
                 seconds += t.elapsed().as_secs_f64();
                 for (k, t) in truth.iter().enumerate() {
                     // The fitted light nearest the truth's centre.
@@ -147,8 +166,12 @@ fn main() {
                     }
                 });
                 let max_z = (0..5).flat_map(zs).map(f64::abs).fold(0.0, f64::max);
+                let max_err = fmt(&|i| {
+                    let largest = column(i).iter().map(|e| e.abs()).fold(0.0, f64::max);
+                    format!("{largest:.2}")
+                });
                 println!(
-                    "| {photo} | {r} | {} | {rms_err} | {mean_err} | {rms_z} | {max_z:.1} | {:.1} |",
+                    "| {photo} | {r} | {} | {rms_err} | {mean_err} | {max_err} | {rms_z} | {max_z:.1} | {:.1} |",
                     truth[k].name,
                     seconds / seeds as f64
                 );
@@ -191,21 +214,35 @@ fn distance(light: &LightReport, truth: &SampleLight) -> f64 {
     (c[0] + light.width / 2.0 - centre.x).hypot(c[1] + light.height / 2.0 - centre.y)
 }
 
-/// `streaklight fit` of `photo` with `seed`, `repeats` and `--joint-samples`: the report's
-/// lights.
-fn fit(
-    dir: &Path,
-    photo: &Path,
+/// The settings of one bench fit.
+struct FitSettings {
     seed: u64,
     repeats: u32,
     joint_samples: Option<u32>,
-) -> Vec<LightReport> {
+    all_pixels: bool,
+    gloss: Option<f32>,
+}
+
+/// `streaklight fit` of `photo` with `settings`: the report's lights.
+fn fit(dir: &Path, photo: &Path, settings: FitSettings) -> Vec<LightReport> {
+    let FitSettings {
+        seed,
+        repeats,
+        joint_samples,
+        all_pixels,
+        gloss,
+    } = settings;
     let options = ConvertOptions {
+        load: LoadOptions {
+            gloss,
+            ..Default::default()
+        },
         exposure: samples::PHOTO_EXPOSURE,
         method: Method::Joint,
         seed,
         repeats,
         joint_samples,
+        all_pixels,
         ..ConvertOptions::new(
             dir.join("scene.gltf"),
             photo,

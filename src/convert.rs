@@ -373,13 +373,20 @@ fn skipped_report(s: &Skipped) -> SkippedStreak {
     }
 }
 
+/// Joint samples per pixel that, with `--all-pixels`, fit lights sharing a streak about twice
+/// as closely as the defaults: on `stacked1000.png` (8 seeds) the facing edges and radiances
+/// 1.2-1.3 % rms off instead of 2.6-2.8 % (BENCHMARKS.md, twelfth session).
+const THOROUGH_SAMPLES: u32 = 128;
+
 /// One warning per set of lights that share streaks (overlapping reflections, split by the
 /// joint fit; a light merged from two streaks and then split makes one warning naming both
 /// streaks): the photo tells such lights apart only weakly, so their facing edges and
 /// radiances can be off by 10 % and more (the stacked sample's lower light: top edge 12 % rms
 /// over 8 seeds). Their reported uncertainties are as wide (BENCHMARKS.md, "Uncertainties: the
-/// curvature of the cost the fit minimises"); the warning says why.
-fn shared_streak_warnings(lights: &[LightReport]) -> Vec<String> {
+/// curvature of the cost the fit minimises"); the warning says why. Unless the fit already
+/// read every pixel with at least [`THOROUGH_SAMPLES`] samples (`thorough`), it also says how
+/// to fit such lights more closely.
+fn shared_streak_warnings(lights: &[LightReport], thorough: bool) -> Vec<String> {
     let mut by_streak: std::collections::BTreeMap<usize, Vec<&str>> = Default::default();
     for light in lights {
         for &streak in &light.streak_ids {
@@ -406,10 +413,18 @@ fn shared_streak_warnings(lights: &[LightReport]) -> Vec<String> {
                 "{noun} {} {verb} {} lights ({}), whose reflections overlap: the photo tells them \
                  apart only weakly where they meet, so their facing edges and radiances may be off \
                  by several percent (up to about 25 % on the bundled stacked sample); their reported \
-                 uncertainties are correspondingly wide",
+                 uncertainties are correspondingly wide{}",
                 ids.join(", "),
                 names.len(),
-                names.join(", ")
+                names.join(", "),
+                if thorough {
+                    String::new()
+                } else {
+                    format!(
+                        "; --all-pixels --joint-samples {THOROUGH_SAMPLES} fits them about twice \
+                         as closely, in about three times the time"
+                    )
+                }
             )
         })
         .collect()
@@ -624,7 +639,8 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         .enumerate()
         .map(|(i, l)| light_report(&scene, l, uncertainties.get(i), light_name(i)))
         .collect();
-    warnings.extend(shared_streak_warnings(&light_reports));
+    let thorough = options.all_pixels && joint_samples >= THOROUGH_SAMPLES;
+    warnings.extend(shared_streak_warnings(&light_reports, thorough));
     {
         let to_write: Vec<LightToWrite> = lights
             .iter()

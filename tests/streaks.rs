@@ -175,7 +175,19 @@ fn mean_display_value(photo: &Photo, b: &BoundingBox) -> f32 {
 
 #[test]
 fn stacked_lights_overlap_into_one_streak_with_both_parts_visible() {
-    let photo = sample_photo("stacked.png");
+    check_stacked_streak("stacked.png");
+}
+
+/// The same lights over smoother water (e = 1000): narrower reflections, still one streak.
+#[test]
+fn stacked_lights_over_smooth_water_still_make_one_streak() {
+    check_stacked_streak("stacked1000.png");
+}
+
+/// The stacked lights' photo `name` gives one streak that covers both reflections, each
+/// clearly visible.
+fn check_stacked_streak(name: &str) {
+    let photo = sample_photo(name);
     let seg = segment(&photo);
     let boxes: Vec<BoundingBox> = seg.streaks.iter().map(|s| s.bbox).collect();
     // One streak: the two reflections are not told apart by the segmentation, which is
