@@ -373,16 +373,35 @@ fn skipped_report(s: &Skipped) -> SkippedStreak {
     }
 }
 
-/// Joint samples per pixel that, with `--all-pixels`, fit lights sharing a streak about twice
-/// as closely as the defaults: on `stacked1000.png` (8 seeds) the facing edges and radiances
-/// 1.2-1.3 % rms off instead of 2.6-2.8 % (BENCHMARKS.md, twelfth session).
+/// Joint samples per pixel of the refit of lights that share a streak (with every pixel
+/// read): on `stacked1000.png` (8 seeds) their facing edges and radiances come out 1.2-1.3 %
+/// rms off instead of 2.6-2.8 % with the checkerboard and 72 samples, in about three times
+/// the time (BENCHMARKS.md, twelfth session).
 const THOROUGH_SAMPLES: u32 = 128;
+
+/// Whether lights that the joint fit finds sharing a streak are fitted again over every pixel
+/// with [`THOROUGH_SAMPLES`] samples: by default yes; not when the user chose the pixels or
+/// the samples (their choice stands), and not under `--gloss auto` (whose final fit has its
+/// own settings).
+fn refit_overlaps(options: &ConvertOptions) -> bool {
+    options.joint_samples.is_none() && !options.all_pixels && !options.estimate_gloss
+}
+
+/// Whether two of `lights` stand for the same streak (the joint fit split it).
+fn shares_a_streak(lights: &[FittedLight]) -> bool {
+    let mut seen = std::collections::BTreeSet::new();
+    lights
+        .iter()
+        .flat_map(|l| l.streak_ids.iter())
+        .any(|&id| !seen.insert(id))
+}
 
 /// One warning per set of lights that share streaks (overlapping reflections, split by the
 /// joint fit; a light merged from two streaks and then split makes one warning naming both
 /// streaks): the photo tells such lights apart only weakly, so their facing edges and
-/// radiances can be off by 10 % and more (the stacked sample's lower light: top edge 12 % rms
-/// over 8 seeds). Their reported uncertainties are as wide (BENCHMARKS.md, "Uncertainties: the
+/// radiances can be off by several percent (the stacked sample, even with the refit over
+/// every pixel: the facing edges about 5 % rms over 8 seeds, the upper light's radiance 7 %,
+/// up to 14 %; BENCHMARKS.md, twelfth session). Their reported uncertainties are as wide (BENCHMARKS.md, "Uncertainties: the
 /// curvature of the cost the fit minimises"); the warning says why. Unless the fit already
 /// read every pixel with at least [`THOROUGH_SAMPLES`] samples (`thorough`), it also says how
 /// to fit such lights more closely.
@@ -412,7 +431,7 @@ fn shared_streak_warnings(lights: &[LightReport], thorough: bool) -> Vec<String>
             format!(
                 "{noun} {} {verb} {} lights ({}), whose reflections overlap: the photo tells them \
                  apart only weakly where they meet, so their facing edges and radiances may be off \
-                 by several percent (up to about 25 % on the bundled stacked sample); their reported \
+                 by several percent (up to about 15 % on the bundled stacked sample); their reported \
                  uncertainties are correspondingly wide{}",
                 ids.join(", "),
                 names.len(),
@@ -540,23 +559,26 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             &fit_options,
         )?)
     };
+    // What the joint fit read in the end: (samples per pixel, every pixel).
+    let mut joint_reading = (joint_samples, options.all_pixels);
     if let (Some(f), Method::Joint, false) = (fit.as_mut(), options.method, options.estimate_gloss)
     {
         if !f.lights.is_empty() {
             clock.say(&format!("joint fit of {} light(s)", f.lights.len()));
-            let refined = joint::fit_joint(
+            let joint_options = |(samples, all_pixels): (u32, bool)| JointOptions {
+                repeats: options.repeats,
+                samples,
+                checkerboard: !all_pixels,
+                progress: options.progress,
+                ..JointOptions::new(fit_options.model, options.seed)
+            };
+            let mut refined = joint::fit_joint(
                 &scene,
                 &photo,
                 &water,
                 &observations,
                 &f.lights,
-                &JointOptions {
-                    repeats: options.repeats,
-                    samples: joint_samples,
-                    checkerboard: !options.all_pixels,
-                    progress: options.progress,
-                    ..JointOptions::new(fit_options.model, options.seed)
-                },
+                &joint_options(joint_reading),
             )?;
             f.timings.extend(
                 refined
@@ -564,6 +586,27 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
                     .iter()
                     .map(|(stage, s)| (format!("joint {stage}"), *s)),
             );
+            if refit_overlaps(options) && shares_a_streak(&refined.lights) {
+                clock.say(&format!(
+                    "lights share a streak: joint fit again over every pixel with \
+                     {THOROUGH_SAMPLES} samples (set --joint-samples or --all-pixels to skip this)"
+                ));
+                joint_reading = (THOROUGH_SAMPLES, true);
+                refined = joint::fit_joint(
+                    &scene,
+                    &photo,
+                    &water,
+                    &observations,
+                    &f.lights,
+                    &joint_options(joint_reading),
+                )?;
+                f.timings.extend(
+                    refined
+                        .timings
+                        .iter()
+                        .map(|(stage, s)| (format!("joint refit of overlaps {stage}"), *s)),
+                );
+            }
             f.lights = refined
                 .lights
                 .iter()
@@ -639,7 +682,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         .enumerate()
         .map(|(i, l)| light_report(&scene, l, uncertainties.get(i), light_name(i)))
         .collect();
-    let thorough = options.all_pixels && joint_samples >= THOROUGH_SAMPLES;
+    let thorough = joint_reading.1 && joint_reading.0 >= THOROUGH_SAMPLES;
     warnings.extend(shared_streak_warnings(&light_reports, thorough));
     {
         let to_write: Vec<LightToWrite> = lights
@@ -692,11 +735,11 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             },
             joint_samples: match (options.method, options.estimate_gloss) {
                 (Method::Paper, false) => None,
-                _ => Some(joint::effective_samples(joint_samples)),
+                _ => Some(joint::effective_samples(joint_reading.0)),
             },
             joint_pixels: match (options.method, options.estimate_gloss) {
                 (Method::Paper, false) => None,
-                _ if options.all_pixels => Some("all".into()),
+                _ if joint_reading.1 => Some("all".into()),
                 _ => Some("checkerboard".into()),
             },
             exposure: options.exposure,

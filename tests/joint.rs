@@ -42,13 +42,28 @@ fn fit_repeated(photo: &str, method: Method, repeats: u32) -> Vec<LightReport> {
 
 /// The whole report of [`fit_repeated`].
 fn fit_report(photo: &str, method: Method, repeats: u32) -> Report {
+    fit_report_options(photo, method, repeats, None)
+}
+
+/// [`fit_report`] with `--joint-samples` given or not.
+fn fit_report_options(
+    photo: &str,
+    method: Method,
+    repeats: u32,
+    joint_samples: Option<u32>,
+) -> Report {
     let dir = scenes();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let tag = format!("{}-{}-{repeats}", photo.replace('.', "_"), method.name());
+    let tag = format!(
+        "{}-{}-{repeats}-{joint_samples:?}",
+        photo.replace('.', "_"),
+        method.name()
+    );
     let options = ConvertOptions {
         exposure: samples::PHOTO_EXPOSURE,
         method,
         repeats,
+        joint_samples,
         ..ConvertOptions::new(
             dir.join("scene.gltf"),
             root.join("samples").join(photo),
@@ -242,9 +257,21 @@ fn joint_splits_overlapping_streaks() {
             .any(|w| w.starts_with("streak 0 holds 2 lights")
                 && w.contains("streaklight_light_0, streaklight_light_1")
                 && w.contains("reported uncertainties")
-                && w.contains("--all-pixels --joint-samples 128")),
+                && !w.contains("--all-pixels")),
         "{:?}",
         report.warnings
+    );
+    // Lights sharing a streak are fitted again over every pixel with 128 samples, and the
+    // report says what the final fit read.
+    assert_eq!(report.settings.joint_pixels.as_deref(), Some("all"));
+    assert_eq!(report.settings.joint_samples, Some(128));
+    assert!(
+        report
+            .timings
+            .iter()
+            .any(|t| t.stage.starts_with("fit: joint refit of overlaps")),
+        "{:?}",
+        report.timings
     );
     let mut joint = report.lights;
     assert_eq!(joint.len(), 2, "the joint fit splits the merged streak");
@@ -309,7 +336,23 @@ fn joint_splits_overlapping_streaks() {
 #[test]
 fn repeated_fits_cover_the_stacked_errors() {
     let truths = samples::stacked_lights();
-    let mut joint = fit_repeated("stacked.png", Method::Joint, 4);
+    // --joint-samples given: the user's choice stands (no refit over every pixel), and the
+    // warning says which settings fit such lights more closely.
+    let report = fit_report_options("stacked.png", Method::Joint, 4, Some(72));
+    assert_eq!(
+        report.settings.joint_pixels.as_deref(),
+        Some("checkerboard")
+    );
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("streak 0 holds 2 lights")
+                && w.contains("--all-pixels --joint-samples 128")),
+        "{:?}",
+        report.warnings
+    );
+    let mut joint = report.lights;
     assert_eq!(joint.len(), 2, "the joint fit splits the merged streak");
     joint.sort_by(|a, b| a.corner_left_bottom[1].total_cmp(&b.corner_left_bottom[1]));
     for (light, truth) in joint.iter().zip(&truths) {
@@ -336,12 +379,13 @@ fn repeated_fits_cover_the_stacked_errors() {
 
 /// The stacked lights over smoother water (`stacked1000.png`, e = 1000): their reflections
 /// still merge into one streak (the paper method fits one light), but narrower lobes let the
-/// photo pin the edges where the two lights meet. Read in full, with the settings the
-/// shared-streak warning suggests (`--all-pixels --joint-samples 128`), both lights come out
-/// within the 2 % for every edge and the radiance: over fit seeds 1-8 (`cargo bench
-/// --bench spread`, BENCHMARKS.md twelfth session) the largest error of any parameter was
-/// 1.9 % (the lower light's radiance), rms 1.3 % or less. Held here for seed 1, with the
-/// report's sigmas (which the bench found covering the errors) and the warning's wording.
+/// photo pin the edges where the two lights meet. At the default settings the joint fit,
+/// having split the streak, fits again over every pixel with 128 samples, and both lights
+/// come out within the 2 % for every edge and the radiance: over fit seeds 1-8
+/// (`cargo bench --bench spread`, BENCHMARKS.md twelfth session) the largest error of any
+/// parameter was 1.9 % (the lower light's radiance), rms 1.3 % or less. Held here for seed 1,
+/// with the report's sigmas (which the bench found covering the errors) and the warning's
+/// wording.
 #[test]
 fn stacked_lights_over_smooth_water_within_two_percent() {
     let dir = scenes();
@@ -354,8 +398,6 @@ fn stacked_lights_over_smooth_water_within_two_percent() {
             },
             exposure: samples::PHOTO_EXPOSURE,
             method,
-            all_pixels: true,
-            joint_samples: Some(128),
             ..ConvertOptions::new(
                 dir.join("scene.gltf"),
                 root.join("samples/stacked1000.png"),
@@ -370,6 +412,7 @@ fn stacked_lights_over_smooth_water_within_two_percent() {
         "the paper sees one light"
     );
     let report = run(Method::Joint);
+    assert_eq!(report.settings.joint_pixels.as_deref(), Some("all"));
     let shared: Vec<&String> = report
         .warnings
         .iter()

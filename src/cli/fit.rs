@@ -56,13 +56,15 @@ pub struct Args {
     /// ...; default 72, or 128 for the final fit of --gloss auto): the time grows with them,
     /// the fit's own noise falls (Table 3's second light, seen only in part: top 0.56 % rms
     /// at 72, 0.26 % at 288, about four times slower; beyond that the photo's own noise is
-    /// what is left).
+    /// what is left). Without this option and --all-pixels, lights the fit finds sharing a
+    /// streak are fitted again over every pixel with 128 samples; with either, they are not.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub joint_samples: Option<u32>,
     /// Fit every water pixel near the streaks instead of every second one (a checkerboard):
     /// about twice the joint fit's time, and less of both the samples' and the photo's noise
-    /// (on the stacked sample, where two lights share a streak, the lower light's top 5.2 %
-    /// rms off instead of 8.8 %; more samples per pixel cannot average the photo's noise).
+    /// (Table 3's second light: top 0.36 % rms off instead of 0.56 %; more samples per pixel
+    /// cannot average the photo's noise). Lights sharing a streak get this by default (see
+    /// --joint-samples).
     #[arg(long)]
     pub all_pixels: bool,
     /// Succeed and write the scene unchanged when no light is found.
