@@ -5,13 +5,16 @@
 //! One photo per case, so what scatters is the fit's samples, not the photo's noise.
 //!
 //! `cargo bench --bench spread` runs 8 seeds of Table 3 and the stacked sample with 1 and 4
-//! repeats (about 8 minutes on 2 cores). Environment: `SPREAD_SEEDS` (count), `SPREAD_REPEATS`
-//! (comma-separated, e.g. "1,4"), `SPREAD_CASES` (comma-separated photo names, e.g.
-//! "table1.png,table3.png,stacked.png,stacked1000.png"), `SPREAD_JOINT_SAMPLES` (`--joint-samples`; unset: the
-//! default), `SPREAD_ALL_PIXELS` ("1": `--all-pixels`), `SPREAD_RENDER_SPP` (fit a fresh render of each case's truth scene with this many
-//! camera rays per pixel instead of the committed 256-spp photo: a photo with less of its own
-//! noise), `SPREAD_RENDER_CACHE` (a directory: such renders are kept there and reused by later
-//! runs, which saves minutes per case; empty it after changing the renderer).
+//! repeats (the stacked sample's fits include the refit of its two lights over every pixel:
+//! 63 s per fit with 1 repeat on 2 cores; with 4 repeats each repeat refits). Environment:
+//! `SPREAD_SEEDS` (count), `SPREAD_REPEATS` (comma-separated, e.g. "1,4"), `SPREAD_CASES`
+//! (comma-separated photo names, e.g. "table1.png,table3.png,stacked.png,stacked1000.png"),
+//! `SPREAD_JOINT_SAMPLES` (`--joint-samples`; unset: the default), `SPREAD_ALL_PIXELS` ("1":
+//! `--all-pixels`), `SPREAD_RENDER_SPP` (fit a fresh render of each case's truth scene with
+//! this many camera rays per pixel instead of the committed 256-spp photo: a photo with less
+//! of its own noise), `SPREAD_RENDER_CACHE` (a directory: such renders are kept there and
+//! reused by later runs, which saves minutes per case; empty it after changing the
+//! renderer).
 
 use std::path::{Path, PathBuf};
 

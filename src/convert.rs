@@ -375,8 +375,8 @@ fn skipped_report(s: &Skipped) -> SkippedStreak {
 
 /// Joint samples per pixel of the refit of lights that share a streak (with every pixel
 /// read): on `stacked1000.png` (8 seeds) their facing edges and radiances come out 1.2-1.3 %
-/// rms off instead of 2.6-2.8 % with the checkerboard and 72 samples, in about three times
-/// the time (BENCHMARKS.md, twelfth session).
+/// rms off instead of 2.6-2.8 % with the checkerboard and 72 samples, in about twice the
+/// time (36 s against 19 s per fit; BENCHMARKS.md, twelfth session).
 const THOROUGH_SAMPLES: u32 = 128;
 
 /// Whether lights that the joint fit finds sharing a streak are fitted again over every pixel
@@ -401,8 +401,9 @@ fn shares_a_streak(lights: &[FittedLight]) -> bool {
 /// streaks): the photo tells such lights apart only weakly, so their facing edges and
 /// radiances can be off by several percent (the stacked sample, even with the refit over
 /// every pixel: the facing edges about 5 % rms over 8 seeds, the upper light's radiance 7 %,
-/// up to 14 %; BENCHMARKS.md, twelfth session). Their reported uncertainties are as wide (BENCHMARKS.md, "Uncertainties: the
-/// curvature of the cost the fit minimises"); the warning says why. Unless the fit already
+/// up to 14 %; BENCHMARKS.md, twelfth session). Their reported uncertainties are as wide
+/// (BENCHMARKS.md, "Uncertainties: the curvature of the cost the fit minimises"); the
+/// warning says why. Unless the fit already
 /// read every pixel with at least [`THOROUGH_SAMPLES`] samples (`thorough`), it also says how
 /// to fit such lights more closely.
 fn shared_streak_warnings(lights: &[LightReport], thorough: bool) -> Vec<String> {
@@ -441,7 +442,7 @@ fn shared_streak_warnings(lights: &[LightReport], thorough: bool) -> Vec<String>
                 } else {
                     format!(
                         "; --all-pixels --joint-samples {THOROUGH_SAMPLES} fits them about twice \
-                         as closely, in about three times the time"
+                         as closely, in about twice the time"
                     )
                 }
             )
