@@ -566,47 +566,42 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     {
         if !f.lights.is_empty() {
             clock.say(&format!("joint fit of {} light(s)", f.lights.len()));
-            let joint_options = |(samples, all_pixels): (u32, bool)| JointOptions {
-                repeats: options.repeats,
-                samples,
-                checkerboard: !all_pixels,
-                progress: options.progress,
-                ..JointOptions::new(fit_options.model, options.seed)
+            // One joint fit from the paper's lights, reading `(samples, every pixel)`; its
+            // timings are added under `label`.
+            let run_joint = |(samples, all_pixels): (u32, bool),
+                             label: &str,
+                             timings: &mut Vec<(String, f64)>|
+             -> Result<joint::JointOutcome> {
+                let outcome = joint::fit_joint(
+                    &scene,
+                    &photo,
+                    &water,
+                    &observations,
+                    &f.lights,
+                    &JointOptions {
+                        repeats: options.repeats,
+                        samples,
+                        checkerboard: !all_pixels,
+                        progress: options.progress,
+                        ..JointOptions::new(fit_options.model, options.seed)
+                    },
+                )?;
+                timings.extend(
+                    outcome
+                        .timings
+                        .iter()
+                        .map(|(stage, s)| (format!("{label} {stage}"), *s)),
+                );
+                Ok(outcome)
             };
-            let mut refined = joint::fit_joint(
-                &scene,
-                &photo,
-                &water,
-                &observations,
-                &f.lights,
-                &joint_options(joint_reading),
-            )?;
-            f.timings.extend(
-                refined
-                    .timings
-                    .iter()
-                    .map(|(stage, s)| (format!("joint {stage}"), *s)),
-            );
+            let mut refined = run_joint(joint_reading, "joint", &mut f.timings)?;
             if refit_overlaps(options) && shares_a_streak(&refined.lights) {
                 clock.say(&format!(
                     "lights share a streak: joint fit again over every pixel with \
                      {THOROUGH_SAMPLES} samples (set --joint-samples or --all-pixels to skip this)"
                 ));
                 joint_reading = (THOROUGH_SAMPLES, true);
-                refined = joint::fit_joint(
-                    &scene,
-                    &photo,
-                    &water,
-                    &observations,
-                    &f.lights,
-                    &joint_options(joint_reading),
-                )?;
-                f.timings.extend(
-                    refined
-                        .timings
-                        .iter()
-                        .map(|(stage, s)| (format!("joint refit of overlaps {stage}"), *s)),
-                );
+                refined = run_joint(joint_reading, "joint refit of overlaps", &mut f.timings)?;
             }
             f.lights = refined
                 .lights
