@@ -38,7 +38,16 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
-    /// Arguments that do not make sense together, or a value out of range.
+    /// A setting's value is out of range: `setting` names it in the library's terms (a front
+    /// end spells it its own way, [`crate::settings::reword`]).
+    #[error("{setting} {problem}")]
+    Setting {
+        /// The setting.
+        setting: crate::settings::Setting,
+        /// What is wrong with its value, completing "`setting` ...".
+        problem: String,
+    },
+    /// Inputs that do not fit together, or a value out of range.
     #[error("{0}")]
     Usage(String),
     /// The input was read, but the method found nothing to work with.
@@ -69,6 +78,13 @@ impl Error {
         Error::Photo {
             path: path.into(),
             message: message.into(),
+        }
+    }
+    /// `setting`'s value is wrong: `problem` completes "`setting` ...".
+    pub fn setting(setting: crate::settings::Setting, problem: impl Into<String>) -> Self {
+        Error::Setting {
+            setting,
+            problem: problem.into(),
         }
     }
     /// A problem producing the output `path`.

@@ -9,6 +9,7 @@ use std::path::Path;
 
 use image::{DynamicImage, ImageDecoder};
 
+use crate::settings::Setting;
 use crate::{Error, Result};
 
 /// A decoded photo. Pixels are stored row by row, row 0 at the top.
@@ -123,9 +124,10 @@ pub fn load(path: &Path, exposure: f32) -> Result<Photo> {
 
 fn check_exposure(exposure: f32) -> Result<()> {
     if !(exposure.is_finite() && exposure > 0.0) {
-        return Err(Error::Usage(format!(
-            "--exposure must be a positive number, not {exposure}"
-        )));
+        return Err(Error::setting(
+            Setting::Exposure,
+            format!("must be a positive number, not {exposure}"),
+        ));
     }
     Ok(())
 }

@@ -15,13 +15,15 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::optics::{ReflectionModel, Shadowing};
+use crate::progress::Reporter;
 use crate::random::Rng;
 use crate::scene_in::{AreaLight, Scene};
+use crate::settings::Setting;
 use crate::{Error, Result};
 
 /// How to render.
 #[derive(Clone, Debug)]
-pub struct RenderOptions {
+pub struct RenderOptions<'a> {
     /// Image width in pixels.
     pub width: u32,
     /// Image height in pixels.
@@ -35,11 +37,11 @@ pub struct RenderOptions {
     pub seed: u64,
     /// Shadowing term of the reflection model.
     pub shadowing: Shadowing,
-    /// Show a progress bar on stderr (only drawn when stderr is a terminal).
-    pub progress: bool,
+    /// Told the rows done as they finish (silent by default).
+    pub progress: Reporter<'a>,
 }
 
-impl Default for RenderOptions {
+impl Default for RenderOptions<'_> {
     fn default() -> Self {
         RenderOptions {
             width: 600,
@@ -48,7 +50,7 @@ impl Default for RenderOptions {
             exposure: 1.0,
             seed: 1,
             shadowing: Shadowing::None,
-            progress: false,
+            progress: Reporter::default(),
         }
     }
 }
@@ -224,13 +226,13 @@ pub fn render_with_lights(
         )));
     }
     if options.samples_per_pixel == 0 {
-        return Err(Error::Usage("--spp must be at least 1".into()));
+        return Err(Error::setting(Setting::RenderSamples, "must be at least 1"));
     }
     if !(options.exposure.is_finite() && options.exposure > 0.0) {
-        return Err(Error::Usage(format!(
-            "--exposure must be a positive number, not {}",
-            options.exposure
-        )));
+        return Err(Error::setting(
+            Setting::Exposure,
+            format!("must be a positive number, not {}", options.exposure),
+        ));
     }
     let model = ReflectionModel {
         gloss: scene.water.gloss,
@@ -239,7 +241,8 @@ pub fn render_with_lights(
     };
     let start = Instant::now();
     let reflected = AtomicU64::new(0);
-    let bar = progress_bar(options.progress, h as u64);
+    let rows_done = AtomicU64::new(0);
+    options.progress.advance(0, h as u64);
     let mut pixels = vec![[0f32; 3]; w as usize * h as usize];
     pixels
         .par_chunks_mut(w as usize)
@@ -278,9 +281,9 @@ pub fn render_with_lights(
                 *out = sum.map(|s| (s * scale) as f32);
             }
             reflected.fetch_add(row_reflected, Ordering::Relaxed);
-            bar.inc(1);
+            let done = rows_done.fetch_add(1, Ordering::Relaxed) + 1;
+            options.progress.advance(done, h as u64);
         });
-    bar.finish_and_clear();
     Ok(Rendered {
         width: w,
         height: h,
@@ -361,16 +364,3 @@ fn pixel_sample(
     (sum.map(|c| c * inv), traced)
 }
 
-fn progress_bar(enabled: bool, rows: u64) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !enabled || !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(rows);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "rendering {bar:40} {pos}/{len} rows, {elapsed} elapsed, ~{eta} left",
-    ) {
-        bar.set_style(style);
-    }
-    bar
-}

@@ -2,7 +2,9 @@
 
 use std::path::PathBuf;
 
-use streaklight::convert::{convert, describe, ConvertOptions, Method};
+use streaklight::convert::{convert, ConvertOptions};
+use streaklight::pipeline::{FitSettings, JointSettings, Method};
+use streaklight::progress::Reporter;
 
 use super::scene_args::SceneArgs;
 use super::streak_args::StreakArgs;
@@ -78,9 +80,50 @@ pub struct Args {
     pub streak: StreakArgs,
 }
 
+impl Args {
+    /// The fit's settings: the method carries its own (the joint fit's reading, refit and
+    /// gloss); `--method paper` with joint-fit options is refused by the argument parser.
+    fn fit_settings(&self) -> streaklight::Result<FitSettings> {
+        let method = if self.method == "paper" {
+            if matches!(self.gloss, Some(GlossArg::Auto)) {
+                return Err(streaklight::Error::Usage(
+                    "--gloss auto fits the gloss with the joint fit: it cannot be combined with \
+                     --method paper"
+                        .into(),
+                ));
+            }
+            Method::Paper
+        } else {
+            let mut joint = match self.gloss {
+                Some(GlossArg::Auto) => JointSettings::estimating_gloss(),
+                _ => JointSettings::default(),
+            };
+            joint.repeats = self.repeats;
+            if self.joint_samples.is_some() || self.all_pixels {
+                // The user chose what the fit reads: that choice stands for every light.
+                joint.overlap_refit = None;
+            }
+            if let Some(samples) = self.joint_samples {
+                joint.reading.samples = samples;
+            }
+            joint.reading.all_pixels |= self.all_pixels;
+            Method::Joint(joint)
+        };
+        Ok(FitSettings {
+            samples: self.samples,
+            seed: self.seed,
+            shadowing: self.scene_options.shadowing(),
+            streaks: self.streak.params()?,
+            method,
+        })
+    }
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> streaklight::Result<()> {
+    let terminal = super::progress::Terminal::new();
     let options = ConvertOptions {
+        fit: args.fit_settings()?,
         scene: args.scene,
         photo: args.photo,
         output: args.output,
@@ -91,22 +134,10 @@ pub fn run(args: Args) -> streaklight::Result<()> {
             _ => None,
         }),
         exposure: args.exposure,
-        samples: args.samples,
-        seed: args.seed,
-        shadowing: args.scene_options.shadowing(),
         fallback_quads: !args.no_fallback_quads,
         allow_empty: args.allow_empty,
-        streak_params: args.streak.params()?,
-        method: if args.method == "paper" {
-            Method::Paper
-        } else {
-            Method::Joint
-        },
-        estimate_gloss: matches!(args.gloss, Some(GlossArg::Auto)),
-        repeats: args.repeats,
-        joint_samples: args.joint_samples,
-        all_pixels: args.all_pixels,
-        progress: Some(|line| eprintln!("{line}")),
+        progress: Reporter::new(&terminal),
+        wording: super::flags::flag,
     };
     let outcome = convert(&options)?;
     for w in &outcome.report.warnings {
@@ -127,7 +158,6 @@ pub fn run(args: Args) -> streaklight::Result<()> {
             light.radiance[2]
         );
     }
-    let _ = describe;
     let total: f64 = outcome.report.timings.iter().map(|t| t.seconds).sum();
     eprintln!(
         "wrote {} with {} light(s) in {:.2} s",

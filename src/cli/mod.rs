@@ -1,6 +1,8 @@
 //! One file per subcommand: its arguments and a `run` that calls the library.
 
 pub mod fit;
+pub mod flags;
+pub mod progress;
 pub mod render;
 pub mod samples;
 pub mod scene_args;

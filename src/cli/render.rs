@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use streaklight::progress::{Progress, Reporter};
 use streaklight::render::{render, RenderOptions};
 use streaklight::scene_in;
 use streaklight::{output_file, photo_out};
@@ -60,6 +61,8 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         let aspect = scene.camera.aspect_ratio.unwrap_or(1.0);
         ((args.width as f32 / aspect).round() as u32).max(1)
     });
+    let terminal = super::progress::Terminal::new();
+    terminal.stage("rendering");
     let options = RenderOptions {
         width: args.width,
         height,
@@ -67,7 +70,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         exposure: args.exposure,
         seed: args.seed,
         shadowing: args.scene_options.shadowing(),
-        progress: true,
+        progress: Reporter::new(&terminal),
     };
     let image = render(&scene, &options)?;
     photo_out::write(&args.output, image.width, image.height, &image.pixels)?;

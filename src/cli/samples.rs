@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use streaklight::progress::Reporter;
 use streaklight::samples;
 
 /// Arguments of `streaklight samples`.
@@ -24,7 +25,8 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         eprintln!("wrote {}", path.display());
     }
     if !args.scenes_only {
-        for path in samples::render_photos(&args.dir, args.spp, true)? {
+        let terminal = super::progress::Terminal::new();
+        for path in samples::render_photos(&args.dir, args.spp, Reporter::new(&terminal))? {
             eprintln!("wrote {}", path.display());
         }
     }

@@ -456,7 +456,7 @@ pub fn render_photo(
     dir: &Path,
     spec: &SampleScene,
     spp: u32,
-    progress: bool,
+    progress: crate::progress::Reporter<'_>,
 ) -> Result<crate::render::Rendered> {
     let scene = crate::scene_in::load(&dir.join(&spec.file), &Default::default())?;
     let options = crate::render::RenderOptions {
@@ -473,10 +473,15 @@ pub fn render_photo(
 
 /// Renders the photo of every sample scene that has one (the scenes must be written
 /// already), with `spp` camera rays per pixel; returns the files written.
-pub fn render_photos(dir: &Path, spp: u32, progress: bool) -> Result<Vec<PathBuf>> {
+pub fn render_photos(
+    dir: &Path,
+    spp: u32,
+    progress: crate::progress::Reporter<'_>,
+) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     for spec in catalogue() {
         let Some(photo) = &spec.photo else { continue };
+        progress.stage(&format!("rendering {photo}"));
         let image = render_photo(dir, &spec, spp, progress)?;
         let path = dir.join(photo);
         crate::photo_out::write(&path, image.width, image.height, &image.pixels)?;

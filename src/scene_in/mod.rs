@@ -20,6 +20,7 @@ pub use meshes::{is_fallback_quad, TriangleSource};
 pub use nodes::{world_instances, NodeInstance};
 pub use water::{gloss_from_roughness, roughness_from_gloss, Water, DEFAULT_GLOSS, WATER_IOR};
 
+use crate::settings::Setting;
 use crate::tracing::{Tracer, Triangle};
 use crate::{Error, Result};
 
@@ -81,25 +82,26 @@ pub struct Scene {
     pub node_names: Vec<Option<String>>,
 }
 
-fn check_override(value: Option<f32>, what: &str, min_exclusive: f32) -> Result<()> {
+fn check_override(value: Option<f32>, what: Setting, min_exclusive: f32) -> Result<()> {
     if let Some(v) = value {
         if !(v.is_finite() && v > min_exclusive) {
-            return Err(Error::Usage(format!(
-                "{what} must be a number greater than {min_exclusive}, not {v}"
-            )));
+            return Err(Error::setting(
+                what,
+                format!("must be a number greater than {min_exclusive}, not {v}"),
+            ));
         }
     }
     Ok(())
 }
 
 fn check_options(options: &LoadOptions) -> Result<()> {
-    check_override(options.gloss, "--gloss", 0.0)?;
-    check_override(options.ior, "--ior", 1.0)?;
+    check_override(options.gloss, Setting::Gloss, 0.0)?;
+    check_override(options.ior, Setting::Ior, 1.0)?;
     if !(options.nits_scale.is_finite() && options.nits_scale > 0.0) {
-        return Err(Error::Usage(format!(
-            "--nits-scale must be a positive number, not {}",
-            options.nits_scale
-        )));
+        return Err(Error::setting(
+            Setting::NitsScale,
+            format!("must be a positive number, not {}", options.nits_scale),
+        ));
     }
     Ok(())
 }

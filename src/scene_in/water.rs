@@ -4,6 +4,7 @@ use serde_json::Value;
 
 use super::meshes::is_fallback_quad;
 use super::nodes::NodeInstance;
+use crate::settings::Setting;
 
 /// The water surface and its optical constants.
 #[derive(Clone, Debug)]
@@ -110,7 +111,8 @@ pub fn choose(
             names(&mesh_nodes)
         )),
         (0, None) => Err(format!(
-            "no water node: no mesh node's name contains \"water\"; pass --water NAME. The mesh nodes are: {}",
+            "no water node: no mesh node's name contains \"water\"; {} names it. The mesh nodes are: {}",
+            Setting::Water,
             names(&mesh_nodes)
         )),
         (_, Some(want)) => Err(format!(
@@ -118,8 +120,9 @@ pub fn choose(
             names(&candidates)
         )),
         (_, None) => Err(format!(
-            "several nodes could be the water: {}; pass --water NAME to choose one",
-            names(&candidates)
+            "several nodes could be the water: {}; {} chooses one",
+            names(&candidates),
+            Setting::Water
         )),
     }
 }
@@ -141,14 +144,15 @@ pub fn optics(
         .map(|p| p.material())
         .filter(|m| m.index().is_some());
     let (gloss, gloss_source) = match (gloss_override, &material) {
-        (Some(e), _) => (e, "--gloss".to_owned()),
+        (Some(e), _) => (e, Setting::Gloss.to_string()),
         (None, Some(m)) => {
             let r = m.pbr_metallic_roughness().roughness_factor();
             (gloss_from_roughness(r), format!("material roughness {r}"))
         }
         (None, None) => {
             warnings.push(format!(
-                "the water \"{name}\" has no material; using gloss e = {DEFAULT_GLOSS} (pass --gloss to set it)"
+                "the water \"{name}\" has no material; using gloss e = {DEFAULT_GLOSS} ({} sets it)",
+                Setting::Gloss
             ));
             (DEFAULT_GLOSS, "default".to_owned())
         }

@@ -1,5 +1,8 @@
 //! The machine-readable report of a fit (`--report`), described by `schema/report.schema.json`.
 
+mod build;
+
+pub use build::{build, light_report, Run};
 use serde::Serialize;
 
 /// Version of the report's shape; bumped when a field changes meaning.
@@ -42,7 +45,7 @@ pub struct Files {
 pub struct Settings {
     /// Blinn-Phong gloss e.
     pub gloss: f32,
-    /// Where the gloss came from ("--gloss", "material roughness 0.25", ...).
+    /// Where the gloss came from ("`LoadOptions::gloss`", "material roughness 0.25", ...).
     pub gloss_source: String,
     /// Index of refraction of the water.
     pub ior: f32,
@@ -58,7 +61,7 @@ pub struct Settings {
     /// method).
     pub joint_samples: Option<u32>,
     /// Which pixels of its region the (final) joint fit read: "checkerboard" (every second
-    /// one, the default) or "all" (`--all-pixels`); `None` for the paper method.
+    /// one, the default) or "all" ([`crate::pipeline::Reading::all_pixels`]); `None` for the paper method.
     pub joint_pixels: Option<String>,
     /// Divisor applied to the photo's linear values.
     pub exposure: f32,

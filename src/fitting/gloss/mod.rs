@@ -1,5 +1,5 @@
-//! Estimating the water's gloss exponent `e` from the photo together with the lights (the
-//! library side of a `--gloss auto`; the converter does not call it yet).
+//! Estimating the water's gloss exponent `e` from the photo together with the lights
+//! ([`crate::pipeline::GlossFit::Estimate`]).
 //!
 //! The paper takes `e` as known. A wrong `e` does not stop a fit: the lights come out with
 //! the wrong size and radiance (a lobe that is too wide is answered by a light that is too
@@ -80,6 +80,8 @@
 //! gap between the lights. `table3.png` (two lights side by side, one reaching out of the
 //! photo) gives 502.
 
+mod search;
+
 use std::time::Instant;
 
 use super::joint::{self, fit_joint, JointOptions, Uncertainty};
@@ -88,14 +90,12 @@ use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
 use crate::{Error, Result};
+use search::{search, Point, Stop};
 
-/// How to search for the gloss.
-#[derive(Clone, Copy, Debug)]
+/// How to search for the gloss. What the fits themselves read (samples, pixels, repeats,
+/// seed) is the joint fit's options, given beside it to [`estimate_gloss`].
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GlossSearch {
-    /// The paper fit that gives every candidate its start: samples, seed, IOR and shadowing,
-    /// and `model.gloss`, the first guess of the gloss (the scene's, typically). The seed is
-    /// also the joint fits'.
-    pub fit: FitOptions,
     /// Smallest gloss considered.
     pub min_gloss: f32,
     /// Largest gloss considered.
@@ -115,34 +115,16 @@ pub struct GlossSearch {
     pub search_samples: u32,
     /// Coordinate-descent sweeps of the search's joint fits.
     pub search_sweeps: u32,
-    /// Joint-fit samples per pixel of the final fit at the estimate (which runs the joint
-    /// fit's default sweeps).
-    pub final_samples: u32,
-    /// Independent final fits at the estimate whose mean is the result
-    /// ([`JointOptions::repeats`]).
-    pub final_repeats: u32,
-    /// Whether the final fit reads a checkerboard half of its region's pixels
-    /// ([`JointOptions::checkerboard`]; the search always does).
-    pub final_checkerboard: bool,
-    /// Told a line as each joint fit of the search, and the final fit (and its repeats),
-    /// starts (None: silent): the search takes tens of seconds.
-    pub progress: Option<fn(&str)>,
 }
 
-/// Joint-fit samples per pixel of the search and of the final fit (module doc: the cost is
-/// not to be trusted with fewer; the joint fit's own default is lower).
+/// Joint-fit samples per pixel of the search and, by default, of the final fit (module doc:
+/// the cost is not to be trusted with fewer; the joint fit's own default is lower).
 pub const SEARCH_SAMPLES: u32 = 128;
 
-impl GlossSearch {
-    /// Defaults for a scene: start at its water's gloss, search `e` in [50, 5000].
-    pub fn for_scene(scene: &Scene) -> Self {
-        Self::starting_from(FitOptions::for_scene(scene))
-    }
-
-    /// Defaults for the paper fit `fit` (whose model's gloss is the start).
-    pub fn starting_from(fit: FitOptions) -> Self {
+impl Default for GlossSearch {
+    /// Search `e` in [50, 5000] from the start.
+    fn default() -> Self {
         GlossSearch {
-            fit,
             min_gloss: 50.0,
             max_gloss: 5000.0,
             first_step_ln: 0.15,
@@ -152,14 +134,12 @@ impl GlossSearch {
             max_evaluations: 12,
             search_samples: SEARCH_SAMPLES,
             search_sweeps: 6,
-            final_samples: SEARCH_SAMPLES,
-            final_repeats: 1,
-            final_checkerboard: true,
-            progress: None,
         }
     }
+}
 
-    fn validate(&self) -> Result<()> {
+impl GlossSearch {
+    fn validate(&self, paper: &FitOptions, final_fit: &JointOptions) -> Result<()> {
         let bad = |what: &str| Err(Error::Usage(format!("gloss search: {what}")));
         if !(self.min_gloss.is_finite() && self.min_gloss > 0.0) {
             return bad(&format!(
@@ -173,10 +153,10 @@ impl GlossSearch {
                 self.max_gloss, self.min_gloss
             ));
         }
-        if !(self.fit.model.gloss.is_finite() && self.fit.model.gloss > 0.0) {
+        if !(paper.model.gloss.is_finite() && paper.model.gloss > 0.0) {
             return bad(&format!(
                 "the starting gloss must be positive, not {}",
-                self.fit.model.gloss
+                paper.model.gloss
             ));
         }
         for (name, v) in [
@@ -192,10 +172,10 @@ impl GlossSearch {
         if self.max_evaluations < 3 {
             return bad("at least 3 evaluations are needed to bracket a minimum");
         }
-        if self.search_samples == 0 || self.final_samples == 0 || self.fit.samples == 0 {
+        if self.search_samples == 0 || final_fit.samples == 0 || paper.samples == 0 {
             return bad("the fits need at least one sample per pixel");
         }
-        if self.final_repeats == 0 {
+        if final_fit.repeats == 0 {
             return bad("the final fit needs at least one repeat");
         }
         Ok(())
@@ -215,13 +195,16 @@ pub struct GlossEstimate {
     /// Every cost evaluation in the order made: (gloss, residual sum of squares of the joint
     /// fit at it, radiance units squared; infinite where the fit broke down).
     pub evaluations: Vec<(f32, f64)>,
-    /// The lights jointly fitted at the estimated gloss ([`GlossSearch::final_samples`]
-    /// samples), edges the photo does not constrain marked as such.
+    /// The lights jointly fitted at the estimated gloss (with the final fit's options), edges
+    /// the photo does not constrain marked as such.
     pub lights: Vec<FittedLight>,
     /// Their uncertainties at that gloss (the gloss's own uncertainty not included).
     pub uncertainty: Vec<Uncertainty>,
     /// The final fit's residual variance per pixel and channel.
     pub residual_variance: f64,
+    /// The paper fit's lights at the starting gloss: every candidate's start, and the final
+    /// fit's.
+    pub start: Vec<FittedLight>,
     /// Streaks the paper fit could not turn into a light (left out of the search).
     pub skipped: Vec<Skipped>,
     /// Things the user should know (the paper fit's warnings, a minimum at a search limit).
@@ -235,16 +218,22 @@ pub struct GlossEstimate {
 /// doc for the method).
 ///
 /// The inputs are those of [`fit_paper`]: the photo, its water mask and the streaks found in
-/// it. Fails on inconsistent inputs, bad search options, when there is no streak, and when no
-/// streak gives a light (the message says why for each).
+/// it. `paper` is the paper fit that gives every candidate its start (its `model.gloss` is
+/// the first guess, the scene's typically; its seed is also the search's fits'); `final_fit`
+/// is the joint fit run at the estimate (its model's gloss is replaced by the estimate; its
+/// progress reporter hears each evaluation). Fails on inconsistent inputs, bad search
+/// options, when there is no streak, and when no streak gives a light (the message says why
+/// for each).
 pub fn estimate_gloss(
     scene: &Scene,
     photo: &Photo,
     water: &[bool],
     streaks: &[StreakObservation],
+    paper: &FitOptions,
+    final_fit: &JointOptions,
     options: &GlossSearch,
 ) -> Result<GlossEstimate> {
-    options.validate()?;
+    options.validate(paper, final_fit)?;
     super::check_sizes(photo, water)?;
     if streaks.is_empty() {
         return Err(Error::NothingFound(
@@ -255,21 +244,22 @@ pub fn estimate_gloss(
         (options.min_gloss as f64).ln(),
         (options.max_gloss as f64).ln(),
     );
-    let x0 = (options.fit.model.gloss as f64).ln().clamp(lo, hi);
+    let x0 = (paper.model.gloss as f64).ln().clamp(lo, hi);
     let mut timings = Vec::new();
 
     // The common start: the paper fit at the first guess.
     let t = Instant::now();
     let start_options = FitOptions {
         model: ReflectionModel {
-            gloss: options
-                .fit
-                .model
-                .gloss
-                .clamp(options.min_gloss, options.max_gloss),
-            ..options.fit.model
+            gloss: paper.model.gloss.clamp(options.min_gloss, options.max_gloss),
+            ..paper.model
         },
-        ..options.fit
+        ..*paper
+    };
+    let search_fit = SearchFit {
+        model: paper.model,
+        seed: paper.seed,
+        progress: final_fit.progress,
     };
     let paper = fit_paper(scene, photo, water, streaks, &start_options)?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
@@ -313,6 +303,7 @@ pub fn estimate_gloss(
         streaks,
         start: &start,
         options,
+        fit: search_fit,
         evaluations: Vec::new(),
         failed: Vec::new(),
     };
@@ -343,7 +334,7 @@ pub fn estimate_gloss(
     }
 
     // The lights at the estimate, fitted in full from the same start.
-    if let Some(say) = options.progress {
+    if let Some(say) = final_fit.progress {
         say(&format!("gloss search: final joint fit at e = {gloss:.0}"));
     }
     let t = Instant::now();
@@ -354,11 +345,11 @@ pub fn estimate_gloss(
         streaks,
         &paper.lights,
         &JointOptions {
-            samples: options.final_samples,
-            repeats: options.final_repeats,
-            checkerboard: options.final_checkerboard,
-            progress: options.progress,
-            ..JointOptions::new(model_at(options, gloss), options.fit.seed)
+            model: ReflectionModel {
+                gloss,
+                ..final_fit.model
+            },
+            ..*final_fit
         },
     )?;
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
@@ -382,6 +373,7 @@ pub fn estimate_gloss(
         lights,
         uncertainty: final_fit.uncertainty,
         residual_variance: final_fit.residual_variance,
+        start: paper.lights,
         skipped: paper.skipped,
         warnings,
         timings,
@@ -396,12 +388,13 @@ fn skipped_message(s: &Skipped) -> String {
     }
 }
 
-/// The search's reflection model at `gloss`.
-fn model_at(options: &GlossSearch, gloss: f32) -> ReflectionModel {
-    ReflectionModel {
-        gloss,
-        ..options.fit.model
-    }
+/// What the search's fits share: the start's model (the gloss varies), the seed, and whom
+/// to tell as each starts.
+#[derive(Clone, Copy)]
+struct SearchFit {
+    model: ReflectionModel,
+    seed: u64,
+    progress: Option<fn(&str)>,
 }
 
 /// The gloss whose lobe picks the fitted pixels for every candidate: a quarter of the start
@@ -409,8 +402,8 @@ fn model_at(options: &GlossSearch, gloss: f32) -> ReflectionModel {
 /// search visits from there. Costs are comparable only over the same pixels; with the region
 /// following each candidate's own lobe, a broader lobe could add faint pixels and with them
 /// cost (on the samples the streaks' boxes bound the region, so it did not change).
-fn region_gloss(options: &GlossSearch) -> f32 {
-    (options.fit.model.gloss / 4.0).max(options.min_gloss)
+fn region_gloss(options: &GlossSearch, start: f32) -> f32 {
+    (start / 4.0).max(options.min_gloss)
 }
 
 /// The cost of a candidate gloss, with a record of every evaluation.
@@ -421,6 +414,7 @@ struct Cost<'a> {
     streaks: &'a [StreakObservation],
     start: &'a [FittedLight],
     options: &'a GlossSearch,
+    fit: SearchFit,
     /// (ln e, cost), in the order evaluated.
     evaluations: Vec<(f64, f64)>,
     /// Evaluations whose fit broke down (module doc), for a warning.
@@ -431,7 +425,7 @@ impl Cost<'_> {
     /// The cost at `x = ln e` as a point of the curve.
     fn point(&mut self, x: f64) -> Result<Point> {
         let gloss = x.exp() as f32;
-        if let Some(say) = self.options.progress {
+        if let Some(say) = self.fit.progress {
             say(&format!(
                 "gloss search: joint fit {} of at most {}, at e = {gloss:.0}",
                 self.evaluations.len() + 1,
@@ -450,8 +444,14 @@ impl Cost<'_> {
                 // A wrong gloss leaves a structured residual too: splitting lights there
                 // would fit the lobe's error, not a second light.
                 split: false,
-                region_gloss: Some(region_gloss(self.options)),
-                ..JointOptions::new(model_at(self.options, gloss), self.options.fit.seed)
+                region_gloss: Some(region_gloss(self.options, self.fit.model.gloss)),
+                ..JointOptions::new(
+                    ReflectionModel {
+                        gloss,
+                        ..self.fit.model
+                    },
+                    self.fit.seed,
+                )
             },
         )?;
         let mut s = fit.cost;
@@ -470,272 +470,3 @@ impl Cost<'_> {
     }
 }
 
-/// A point of the cost curve: `x = ln e`, its cost and residual variance.
-#[derive(Clone, Copy, Debug)]
-struct Point {
-    x: f64,
-    s: f64,
-    variance: f64,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Stop {
-    Converged,
-    AtLimit,
-    OutOfEvaluations,
-}
-
-#[derive(Clone, Copy, Debug)]
-struct Found {
-    x: f64,
-    sigma_ln: Option<f64>,
-    stop: Stop,
-}
-
-/// Minimises `cost` over `x = ln e` in [lo, hi] from `x0` (module doc, "Search"); `cost`
-/// gives the point at x (an infinite cost: no evidence there).
-fn search(
-    opts: &GlossSearch,
-    x0: f64,
-    lo: f64,
-    hi: f64,
-    mut cost: impl FnMut(f64) -> Result<Point>,
-) -> Result<Found> {
-    let h = opts.first_step_ln as f64;
-    let tol = opts.tolerance_ln as f64;
-    let max_step = (opts.max_step_ln as f64).max(h);
-    let max_bracket = opts.max_bracket_ln as f64;
-    // Three points around the start, shifted inside the limits.
-    let h0 = h.min(0.5 * (hi - lo));
-    let centre = x0.clamp(lo + h0, hi - h0);
-    let mut pts = Vec::new();
-    for x in [centre - h0, centre, centre + h0] {
-        pts.push(cost(x)?);
-    }
-    loop {
-        pts.sort_by(|p, q| p.x.total_cmp(&q.x));
-        let ib = (0..pts.len())
-            .min_by(|&i, &j| pts[i].s.total_cmp(&pts[j].s))
-            .expect("three points at least");
-        let best = pts[ib];
-        if !best.s.is_finite() {
-            return Err(Error::NothingFound(format!(
-                "the joint fit broke down at every gloss tried ({}): the gloss cannot be \
-                 estimated from this photo",
-                pts.iter()
-                    .map(|p| format!("{:.0}", p.x.exp()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )));
-        }
-        let left = ib.checked_sub(1).map(|i| pts[i]);
-        let right = pts.get(ib + 1).copied();
-        let next = match (left, right) {
-            (Some(l), Some(r)) => {
-                // Bracketed: the parabola through the best point and its neighbours.
-                let vertex = parabola(&[l, best, r]);
-                if let Some((v, k)) = vertex {
-                    if r.x - l.x <= max_bracket + 1e-9 && (v - best.x).abs() < tol {
-                        return Ok(Found {
-                            x: v.clamp(l.x, r.x),
-                            sigma_ln: (k > 0.0).then(|| (best.variance / k).sqrt()),
-                            stop: Stop::Converged,
-                        });
-                    }
-                }
-                let clear = |x: f64| (x - l.x).min(r.x - x).min((x - best.x).abs()) >= 0.5 * tol;
-                match vertex {
-                    Some((v, _)) if (v - best.x).abs() >= tol && clear(v) => v,
-                    // The vertex says "here" (or there is none, a neighbour's fit having
-                    // broken down) but the bracket is too wide to trust a parabola over it:
-                    // narrow its wider side.
-                    _ => {
-                        let (gl, gr) = (best.x - l.x, r.x - best.x);
-                        if gl > gr {
-                            best.x - (0.5 * gl).min(h)
-                        } else {
-                            best.x + (0.5 * gr).min(h)
-                        }
-                    }
-                }
-            }
-            (None, Some(_)) | (Some(_), None) => {
-                // The lowest point is the outermost: the minimum lies beyond it. Step by the
-                // parabola through it and its two neighbours, at least h, at most max_step.
-                let dir = if left.is_none() { -1.0 } else { 1.0 };
-                if (dir < 0.0 && best.x <= lo) || (dir > 0.0 && best.x >= hi) {
-                    return Ok(Found {
-                        x: best.x,
-                        sigma_ln: None,
-                        stop: Stop::AtLimit,
-                    });
-                }
-                let tri = if dir < 0.0 {
-                    [pts[0], pts[1], pts[2]]
-                } else {
-                    let n = pts.len();
-                    [pts[n - 3], pts[n - 2], pts[n - 1]]
-                };
-                let neighbour = if dir < 0.0 {
-                    pts[1]
-                } else {
-                    pts[pts.len() - 2]
-                };
-                match parabola(&tri) {
-                    // A vertex between the lowest point and its neighbour (after a long step
-                    // that overshot): try it; if it is lower, the minimum is bracketed.
-                    Some((v, _))
-                        if (v - best.x) * dir < 0.0
-                            && (v - best.x).abs().min((v - neighbour.x).abs()) >= tol
-                            && (v - best.x).abs() < (neighbour.x - best.x).abs() =>
-                    {
-                        v
-                    }
-                    vertex => {
-                        let step = vertex
-                            .map(|(v, _)| (v - best.x) * dir)
-                            .unwrap_or(max_step)
-                            .clamp(h, max_step);
-                        (best.x + dir * step).clamp(lo, hi)
-                    }
-                }
-            }
-            (None, None) => unreachable!("three points at least"),
-        };
-        if pts.len() >= opts.max_evaluations {
-            return Ok(Found {
-                x: best.x,
-                sigma_ln: None,
-                stop: Stop::OutOfEvaluations,
-            });
-        }
-        pts.push(cost(next)?);
-    }
-}
-
-/// The vertex of the parabola through three points and its quadratic coefficient
-/// (`S ~ S0 + k (x - v)^2`); `None` when the points do not determine a convex parabola.
-fn parabola(p: &[Point; 3]) -> Option<(f64, f64)> {
-    let [a, b, c] = p;
-    let d1 = (b.s - a.s) / (b.x - a.x);
-    let d2 = (c.s - b.s) / (c.x - b.x);
-    let k = (d2 - d1) / (c.x - a.x);
-    if !(k.is_finite() && k > 0.0) {
-        return None;
-    }
-    // S = a.s + d1 (x - a.x) + k (x - a.x)(x - b.x); dS/dx = 0 at:
-    let v = 0.5 * (a.x + b.x) - d1 / (2.0 * k);
-    v.is_finite().then_some((v, k))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn pt(x: f64, s: f64) -> Point {
-        Point {
-            x,
-            s,
-            variance: 1.0,
-        }
-    }
-
-    #[test]
-    fn parabola_vertex_and_curvature() {
-        let f = |x: f64| 3.0 + 2.0 * (x - 0.3) * (x - 0.3);
-        let (v, k) = parabola(&[pt(-1.0, f(-1.0)), pt(0.1, f(0.1)), pt(2.0, f(2.0))]).unwrap();
-        assert!((v - 0.3).abs() < 1e-12 && (k - 2.0).abs() < 1e-12);
-        assert!(parabola(&[pt(0.0, 1.0), pt(1.0, 2.0), pt(2.0, 3.0)]).is_none());
-        assert!(parabola(&[pt(0.0, 1.0), pt(1.0, f64::INFINITY), pt(2.0, 3.0)]).is_none());
-    }
-
-    /// The search's options without a scene: the defaults of [`GlossSearch::for_scene`].
-    fn options() -> GlossSearch {
-        GlossSearch::starting_from(FitOptions {
-            samples: 1,
-            seed: 1,
-            model: ReflectionModel::new(500.0, 1.33),
-        })
-    }
-
-    /// Runs the search on `f(ln e)` from e = 500 in [50, 5000]; returns what it found and the
-    /// points it evaluated.
-    fn run(opts: &GlossSearch, f: impl Fn(f64) -> f64) -> (Found, Vec<f64>) {
-        let mut xs = Vec::new();
-        let found = search(opts, 500f64.ln(), 50f64.ln(), 5000f64.ln(), |x| {
-            xs.push(x);
-            Ok(pt(x, f(x)))
-        })
-        .unwrap();
-        (found, xs)
-    }
-
-    /// Like the samples' costs: a parabola in ln e near the minimum, steeper on the low side
-    /// and flattening far away.
-    fn skewed(x: f64, truth: f64) -> f64 {
-        let d = x - truth.ln();
-        let near = if d < 0.0 { 6000.0 } else { 3000.0 } * d * d;
-        1700.0 + near / (1.0 + d * d)
-    }
-
-    #[test]
-    fn finds_minima_on_both_sides_of_the_start() {
-        for truth in [80.0, 200.0, 450.0, 500.0, 560.0, 1000.0, 3000.0] {
-            let (found, xs) = run(&options(), |x| skewed(x, truth));
-            let e = found.x.exp();
-            assert_eq!(found.stop, Stop::Converged, "truth {truth}: {found:?}");
-            assert!((e / truth - 1.0).abs() < 0.03, "truth {truth}: found {e}");
-            assert!(found.sigma_ln.is_some_and(|s| s > 0.0));
-            // A handful from a start within a factor 3; a few more from farther off.
-            let allowed = if (truth / 500.0f64).ln().abs() < 3f64.ln() {
-                8
-            } else {
-                10
-            };
-            assert!(xs.len() <= allowed, "truth {truth}: evaluated at {xs:?}");
-        }
-        // A start near the minimum costs the three first points only.
-        let (_, xs) = run(&options(), |x| skewed(x, 490.0));
-        assert_eq!(xs.len(), 3);
-    }
-
-    #[test]
-    fn a_minimum_beyond_a_limit_is_reported_there() {
-        let (found, _) = run(&options(), |x| -x);
-        assert_eq!(found.stop, Stop::AtLimit);
-        assert!((found.x - 5000f64.ln()).abs() < 1e-9);
-        assert!(found.sigma_ln.is_none());
-        let (found, _) = run(&options(), |x| x);
-        assert_eq!(found.stop, Stop::AtLimit);
-        assert!((found.x - 50f64.ln()).abs() < 1e-9);
-    }
-
-    #[test]
-    fn broken_fits_are_stepped_around() {
-        // No evidence below e = 150 (as a fit that broke down reports); the minimum at 160.
-        let f = |x: f64| {
-            if x < 150f64.ln() {
-                f64::INFINITY
-            } else {
-                skewed(x, 160.0)
-            }
-        };
-        let (found, _) = run(&options(), f);
-        assert!((found.x.exp() / 160.0 - 1.0).abs() < 0.05, "{found:?}");
-        // And nothing but broken fits is an error, not a guess.
-        let all_broken = search(&options(), 6.0, 4.0, 8.0, |x| Ok(pt(x, f64::INFINITY)));
-        assert!(matches!(all_broken, Err(Error::NothingFound(_))));
-    }
-
-    #[test]
-    fn stops_when_the_evaluations_run_out() {
-        let opts = GlossSearch {
-            max_evaluations: 4,
-            ..options()
-        };
-        let (found, xs) = run(&opts, |x| skewed(x, 60.0));
-        assert_eq!(found.stop, Stop::OutOfEvaluations);
-        assert_eq!(xs.len(), 4);
-        assert!(found.sigma_ln.is_none());
-    }
-}

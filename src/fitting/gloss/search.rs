@@ -1,0 +1,271 @@
+//! The one-dimensional search over `x = ln e` that brackets the cost's minimum and refines it
+//! by parabolas (the gloss module's doc, "Search" and "Uncertainty").
+
+use super::GlossSearch;
+use crate::{Error, Result};
+
+/// A point of the cost curve: `x = ln e`, its cost and residual variance.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Point {
+    pub(super) x: f64,
+    pub(super) s: f64,
+    pub(super) variance: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Stop {
+    Converged,
+    AtLimit,
+    OutOfEvaluations,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Found {
+    pub(super) x: f64,
+    pub(super) sigma_ln: Option<f64>,
+    pub(super) stop: Stop,
+}
+
+/// Minimises `cost` over `x = ln e` in [lo, hi] from `x0` (module doc, "Search"); `cost`
+/// gives the point at x (an infinite cost: no evidence there).
+pub(super) fn search(
+    opts: &GlossSearch,
+    x0: f64,
+    lo: f64,
+    hi: f64,
+    mut cost: impl FnMut(f64) -> Result<Point>,
+) -> Result<Found> {
+    let h = opts.first_step_ln as f64;
+    let tol = opts.tolerance_ln as f64;
+    let max_step = (opts.max_step_ln as f64).max(h);
+    let max_bracket = opts.max_bracket_ln as f64;
+    // Three points around the start, shifted inside the limits.
+    let h0 = h.min(0.5 * (hi - lo));
+    let centre = x0.clamp(lo + h0, hi - h0);
+    let mut pts = Vec::new();
+    for x in [centre - h0, centre, centre + h0] {
+        pts.push(cost(x)?);
+    }
+    loop {
+        pts.sort_by(|p, q| p.x.total_cmp(&q.x));
+        let ib = (0..pts.len())
+            .min_by(|&i, &j| pts[i].s.total_cmp(&pts[j].s))
+            .expect("three points at least");
+        let best = pts[ib];
+        if !best.s.is_finite() {
+            return Err(Error::NothingFound(format!(
+                "the joint fit broke down at every gloss tried ({}): the gloss cannot be \
+                 estimated from this photo",
+                pts.iter()
+                    .map(|p| format!("{:.0}", p.x.exp()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        let left = ib.checked_sub(1).map(|i| pts[i]);
+        let right = pts.get(ib + 1).copied();
+        let next = match (left, right) {
+            (Some(l), Some(r)) => {
+                // Bracketed: the parabola through the best point and its neighbours.
+                let vertex = parabola(&[l, best, r]);
+                if let Some((v, k)) = vertex {
+                    if r.x - l.x <= max_bracket + 1e-9 && (v - best.x).abs() < tol {
+                        return Ok(Found {
+                            x: v.clamp(l.x, r.x),
+                            sigma_ln: (k > 0.0).then(|| (best.variance / k).sqrt()),
+                            stop: Stop::Converged,
+                        });
+                    }
+                }
+                let clear = |x: f64| (x - l.x).min(r.x - x).min((x - best.x).abs()) >= 0.5 * tol;
+                match vertex {
+                    Some((v, _)) if (v - best.x).abs() >= tol && clear(v) => v,
+                    // The vertex says "here" (or there is none, a neighbour's fit having
+                    // broken down) but the bracket is too wide to trust a parabola over it:
+                    // narrow its wider side.
+                    _ => {
+                        let (gl, gr) = (best.x - l.x, r.x - best.x);
+                        if gl > gr {
+                            best.x - (0.5 * gl).min(h)
+                        } else {
+                            best.x + (0.5 * gr).min(h)
+                        }
+                    }
+                }
+            }
+            (None, Some(_)) | (Some(_), None) => {
+                // The lowest point is the outermost: the minimum lies beyond it. Step by the
+                // parabola through it and its two neighbours, at least h, at most max_step.
+                let dir = if left.is_none() { -1.0 } else { 1.0 };
+                if (dir < 0.0 && best.x <= lo) || (dir > 0.0 && best.x >= hi) {
+                    return Ok(Found {
+                        x: best.x,
+                        sigma_ln: None,
+                        stop: Stop::AtLimit,
+                    });
+                }
+                let tri = if dir < 0.0 {
+                    [pts[0], pts[1], pts[2]]
+                } else {
+                    let n = pts.len();
+                    [pts[n - 3], pts[n - 2], pts[n - 1]]
+                };
+                let neighbour = if dir < 0.0 {
+                    pts[1]
+                } else {
+                    pts[pts.len() - 2]
+                };
+                match parabola(&tri) {
+                    // A vertex between the lowest point and its neighbour (after a long step
+                    // that overshot): try it; if it is lower, the minimum is bracketed.
+                    Some((v, _))
+                        if (v - best.x) * dir < 0.0
+                            && (v - best.x).abs().min((v - neighbour.x).abs()) >= tol
+                            && (v - best.x).abs() < (neighbour.x - best.x).abs() =>
+                    {
+                        v
+                    }
+                    vertex => {
+                        let step = vertex
+                            .map(|(v, _)| (v - best.x) * dir)
+                            .unwrap_or(max_step)
+                            .clamp(h, max_step);
+                        (best.x + dir * step).clamp(lo, hi)
+                    }
+                }
+            }
+            (None, None) => unreachable!("three points at least"),
+        };
+        if pts.len() >= opts.max_evaluations {
+            return Ok(Found {
+                x: best.x,
+                sigma_ln: None,
+                stop: Stop::OutOfEvaluations,
+            });
+        }
+        pts.push(cost(next)?);
+    }
+}
+
+/// The vertex of the parabola through three points and its quadratic coefficient
+/// (`S ~ S0 + k (x - v)^2`); `None` when the points do not determine a convex parabola.
+fn parabola(p: &[Point; 3]) -> Option<(f64, f64)> {
+    let [a, b, c] = p;
+    let d1 = (b.s - a.s) / (b.x - a.x);
+    let d2 = (c.s - b.s) / (c.x - b.x);
+    let k = (d2 - d1) / (c.x - a.x);
+    if !(k.is_finite() && k > 0.0) {
+        return None;
+    }
+    // S = a.s + d1 (x - a.x) + k (x - a.x)(x - b.x); dS/dx = 0 at:
+    let v = 0.5 * (a.x + b.x) - d1 / (2.0 * k);
+    v.is_finite().then_some((v, k))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pt(x: f64, s: f64) -> Point {
+        Point {
+            x,
+            s,
+            variance: 1.0,
+        }
+    }
+
+    #[test]
+    fn parabola_vertex_and_curvature() {
+        let f = |x: f64| 3.0 + 2.0 * (x - 0.3) * (x - 0.3);
+        let (v, k) = parabola(&[pt(-1.0, f(-1.0)), pt(0.1, f(0.1)), pt(2.0, f(2.0))]).unwrap();
+        assert!((v - 0.3).abs() < 1e-12 && (k - 2.0).abs() < 1e-12);
+        assert!(parabola(&[pt(0.0, 1.0), pt(1.0, 2.0), pt(2.0, 3.0)]).is_none());
+        assert!(parabola(&[pt(0.0, 1.0), pt(1.0, f64::INFINITY), pt(2.0, 3.0)]).is_none());
+    }
+
+    /// The search's default options.
+    fn options() -> GlossSearch {
+        GlossSearch::default()
+    }
+
+    /// Runs the search on `f(ln e)` from e = 500 in [50, 5000]; returns what it found and the
+    /// points it evaluated.
+    fn run(opts: &GlossSearch, f: impl Fn(f64) -> f64) -> (Found, Vec<f64>) {
+        let mut xs = Vec::new();
+        let found = search(opts, 500f64.ln(), 50f64.ln(), 5000f64.ln(), |x| {
+            xs.push(x);
+            Ok(pt(x, f(x)))
+        })
+        .unwrap();
+        (found, xs)
+    }
+
+    /// Like the samples' costs: a parabola in ln e near the minimum, steeper on the low side
+    /// and flattening far away.
+    fn skewed(x: f64, truth: f64) -> f64 {
+        let d = x - truth.ln();
+        let near = if d < 0.0 { 6000.0 } else { 3000.0 } * d * d;
+        1700.0 + near / (1.0 + d * d)
+    }
+
+    #[test]
+    fn finds_minima_on_both_sides_of_the_start() {
+        for truth in [80.0, 200.0, 450.0, 500.0, 560.0, 1000.0, 3000.0] {
+            let (found, xs) = run(&options(), |x| skewed(x, truth));
+            let e = found.x.exp();
+            assert_eq!(found.stop, Stop::Converged, "truth {truth}: {found:?}");
+            assert!((e / truth - 1.0).abs() < 0.03, "truth {truth}: found {e}");
+            assert!(found.sigma_ln.is_some_and(|s| s > 0.0));
+            // A handful from a start within a factor 3; a few more from farther off.
+            let allowed = if (truth / 500.0f64).ln().abs() < 3f64.ln() {
+                8
+            } else {
+                10
+            };
+            assert!(xs.len() <= allowed, "truth {truth}: evaluated at {xs:?}");
+        }
+        // A start near the minimum costs the three first points only.
+        let (_, xs) = run(&options(), |x| skewed(x, 490.0));
+        assert_eq!(xs.len(), 3);
+    }
+
+    #[test]
+    fn a_minimum_beyond_a_limit_is_reported_there() {
+        let (found, _) = run(&options(), |x| -x);
+        assert_eq!(found.stop, Stop::AtLimit);
+        assert!((found.x - 5000f64.ln()).abs() < 1e-9);
+        assert!(found.sigma_ln.is_none());
+        let (found, _) = run(&options(), |x| x);
+        assert_eq!(found.stop, Stop::AtLimit);
+        assert!((found.x - 50f64.ln()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn broken_fits_are_stepped_around() {
+        // No evidence below e = 150 (as a fit that broke down reports); the minimum at 160.
+        let f = |x: f64| {
+            if x < 150f64.ln() {
+                f64::INFINITY
+            } else {
+                skewed(x, 160.0)
+            }
+        };
+        let (found, _) = run(&options(), f);
+        assert!((found.x.exp() / 160.0 - 1.0).abs() < 0.05, "{found:?}");
+        // And nothing but broken fits is an error, not a guess.
+        let all_broken = search(&options(), 6.0, 4.0, 8.0, |x| Ok(pt(x, f64::INFINITY)));
+        assert!(matches!(all_broken, Err(Error::NothingFound(_))));
+    }
+
+    #[test]
+    fn stops_when_the_evaluations_run_out() {
+        let opts = GlossSearch {
+            max_evaluations: 4,
+            ..options()
+        };
+        let (found, xs) = run(&opts, |x| skewed(x, 60.0));
+        assert_eq!(found.stop, Stop::OutOfEvaluations);
+        assert_eq!(xs.len(), 4);
+        assert!(found.sigma_ln.is_none());
+    }
+}

@@ -1,0 +1,403 @@
+//! The whole fit in memory (method §5): a loaded scene and a decoded photo in, the fitted
+//! lights out, with every policy of the method applied in one call. The command line's `fit`
+//! and a Rust caller get the same lights from the same [`fit`].
+//!
+//! The steps: the water mask (step 2), the streaks (steps 3-6), the paper's estimate (steps
+//! 7-9), and for the joint method the refinement of all lights together (the last paragraph of
+//! §5), with the gloss estimated first when asked ([`GlossFit::Estimate`]), lights that share
+//! a streak fitted again ([`JointSettings::overlap_refit`]), and each edge's status taken from
+//! its uncertainty. Files are [`crate::convert`]'s business.
+
+mod photo_check;
+mod settings;
+mod warnings;
+
+use std::time::Instant;
+
+pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
+pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
+
+use crate::fitting::gloss::estimate_gloss;
+use crate::fitting::joint::{self, fit_joint, JointOptions, Uncertainty};
+use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
+use crate::optics::ReflectionModel;
+use crate::photo_in::Photo;
+use crate::progress::Reporter;
+use crate::scene_in::Scene;
+use crate::settings::Setting;
+use crate::streaks::{self, Segmentation};
+use crate::{water_mask, Error, Result};
+
+/// What a fit found.
+#[derive(Clone, Debug)]
+pub struct Lit {
+    /// The fitted lights, in the scene frame of the loaded scene; empty when none was found
+    /// ([`Lit::nothing_found`] says why).
+    pub lights: Vec<FittedLight>,
+    /// The joint fit's uncertainty of each light, in the order of `lights` (empty for the
+    /// paper's method).
+    pub uncertainties: Vec<Uncertainty>,
+    /// Streaks that gave no light.
+    pub skipped: Vec<Skipped>,
+    /// Things the user should know: the scene's own warnings, the fit's, and one per set of
+    /// lights that share a streak.
+    pub warnings: Vec<String>,
+    /// The water's gloss the lights were fitted with.
+    pub gloss: f32,
+    /// Where it came from ("material roughness 0.25", "estimated from the photo ...").
+    pub gloss_source: String,
+    /// What the final joint fit read (`None` for the paper's method).
+    pub reading: Option<Reading>,
+    /// The photo's water mask (method §5 step 2).
+    pub water: Vec<bool>,
+    /// The streak extraction, every stage of it.
+    pub segmentation: Segmentation,
+    /// Why no light was found, when `lights` is empty: which input it is about and what to
+    /// tell the user.
+    pub nothing_found: Option<(Input, String)>,
+    /// Wall-clock seconds per stage, in the order run.
+    pub timings: Vec<(String, f64)>,
+}
+
+/// Which input a message is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Input {
+    /// The scene.
+    Scene,
+    /// The photo.
+    Photo,
+}
+
+/// The name of the `index`-th fitted light in the written scene and the report.
+pub fn light_name(index: usize) -> String {
+    format!("streaklight_light_{index}")
+}
+
+/// A streak as the fitters take it: its id and pixels, and the photo width they index.
+pub fn observation(streak: &streaks::Streak, width: u32) -> StreakObservation {
+    StreakObservation {
+        id: streak.id,
+        pixels: streak.pixels.clone(),
+        brightest: streak.brightest.1 * width + streak.brightest.0,
+        edges: [
+            streak.edges.left.clone(),
+            streak.edges.right.clone(),
+            streak.edges.top.clone(),
+            streak.edges.bottom.clone(),
+        ],
+    }
+}
+
+/// Times each stage and tells the reporter as one starts.
+struct Stopwatch<'a> {
+    timings: Vec<(String, f64)>,
+    progress: Reporter<'a>,
+}
+
+impl Stopwatch<'_> {
+    fn time<T>(&mut self, stage: &str, f: impl FnOnce() -> T) -> T {
+        self.progress.stage(stage);
+        let start = Instant::now();
+        let out = f();
+        self.timings
+            .push((stage.into(), start.elapsed().as_secs_f64()));
+        out
+    }
+
+    /// The fit's own stage times, under "fit: ".
+    fn add_fit(&mut self, timings: &[(String, f64)]) {
+        self.timings
+            .extend(timings.iter().map(|(s, t)| (format!("fit: {s}"), *t)));
+    }
+}
+
+/// Fits lights to the streaks of `photo`, taken by `scene`'s camera (method §5), telling
+/// `progress` as each stage starts.
+///
+/// Fails on settings out of range, a photo that cannot have been taken by the camera (size,
+/// aspect), a camera that sees no water, and inconsistent inputs. Finding no light is not a
+/// failure here: [`Lit::nothing_found`] says why (the converter refuses it unless asked not
+/// to).
+pub fn fit(
+    scene: &Scene,
+    photo: &Photo,
+    settings: &FitSettings,
+    progress: Reporter<'_>,
+) -> Result<Lit> {
+    settings.validate()?;
+    check_photo(scene, photo, std::path::Path::new("the photo"))?;
+    let mut clock = Stopwatch {
+        timings: Vec::new(),
+        progress,
+    };
+    let water = clock.time("water mask", || {
+        water_mask::water_mask(scene, photo.width, photo.height)
+    });
+    if !water.iter().any(|&w| w) {
+        return Err(Error::scene(
+            &scene.path,
+            format!(
+                "the camera \"{}\" sees no water: check {} and {}",
+                scene.camera.name,
+                Setting::Camera,
+                Setting::Water
+            ),
+        ));
+    }
+    let segmentation = clock.time("streaks", || {
+        streaks::extract_streaks(photo, &water, &settings.streaks)
+    })?;
+    // A blank photo (one value over all the water: black, grey, all clipped) shows no
+    // reflection, however the streak extraction reads it.
+    let uniform = warnings::uniform_water(photo, &water);
+    let observations: Vec<StreakObservation> = segmentation
+        .streaks
+        .iter()
+        .filter(|_| uniform.is_none())
+        .map(|s| observation(s, photo.width))
+        .collect();
+    let run = Run {
+        scene,
+        photo,
+        water: &water,
+        observations: &observations,
+        paper: FitOptions {
+            samples: settings.samples,
+            seed: settings.seed,
+            model: ReflectionModel {
+                gloss: scene.water.gloss,
+                ior: scene.water.ior,
+                shadowing: settings.shadowing,
+            },
+        },
+        progress,
+    };
+    let mut found = Found {
+        lights: Vec::new(),
+        uncertainties: Vec::new(),
+        skipped: Vec::new(),
+        warnings: scene.warnings.clone(),
+        gloss: (scene.water.gloss, scene.water.gloss_source.clone()),
+        reading: match &settings.method {
+            Method::Paper => None,
+            Method::Joint(j) => Some(j.reading),
+        },
+        timings: Vec::new(),
+    };
+    if !observations.is_empty() {
+        match &settings.method {
+            Method::Joint(j) if matches!(j.gloss, GlossFit::Estimate(_)) => {
+                run.with_gloss_search(j, &mut found)?
+            }
+            method => {
+                run.paper(&mut found)?;
+                if let Method::Joint(j) = method {
+                    if !found.lights.is_empty() {
+                        run.refine(j, &mut found)?;
+                    }
+                }
+            }
+        }
+    }
+    clock.add_fit(&found.timings);
+    let nothing_found = found
+        .lights
+        .is_empty()
+        .then(|| warnings::nothing_found(uniform, &segmentation, &found.skipped));
+    let thorough = found
+        .reading
+        .is_some_and(|r| r.all_pixels && r.samples >= THOROUGH.samples);
+    found
+        .warnings
+        .extend(warnings::shared_streak_warnings(&found.lights, thorough));
+    Ok(Lit {
+        lights: found.lights,
+        uncertainties: found.uncertainties,
+        skipped: found.skipped,
+        warnings: found.warnings,
+        gloss: found.gloss.0,
+        gloss_source: found.gloss.1,
+        reading: found.reading,
+        water,
+        segmentation,
+        nothing_found,
+        timings: clock.timings,
+    })
+}
+
+/// What the fitters have found so far.
+struct Found {
+    lights: Vec<FittedLight>,
+    uncertainties: Vec<Uncertainty>,
+    skipped: Vec<Skipped>,
+    warnings: Vec<String>,
+    gloss: (f32, String),
+    reading: Option<Reading>,
+    timings: Vec<(String, f64)>,
+}
+
+/// The inputs every fitting stage of one run shares.
+struct Run<'a> {
+    scene: &'a Scene,
+    photo: &'a Photo,
+    water: &'a [bool],
+    observations: &'a [StreakObservation],
+    /// The paper's estimate's options; their model and seed are every fit's.
+    paper: FitOptions,
+    progress: Reporter<'a>,
+}
+
+impl Run<'_> {
+    /// The paper's estimate (method §5 steps 7-9).
+    fn paper(&self, found: &mut Found) -> Result<()> {
+        self.progress.stage(&format!(
+            "fit of {} streak(s): the paper's estimate",
+            self.observations.len()
+        ));
+        let f = fitting::fit_paper(
+            self.scene,
+            self.photo,
+            self.water,
+            self.observations,
+            &self.paper,
+        )?;
+        found.lights = f.lights;
+        found.skipped = f.skipped;
+        found.warnings.extend(f.warnings);
+        found.timings = f.timings;
+        Ok(())
+    }
+
+    /// The joint fit's options for `reading`.
+    fn joint_options(&self, j: &JointSettings, reading: Reading) -> JointOptions {
+        JointOptions {
+            repeats: j.repeats,
+            samples: reading.samples,
+            checkerboard: !reading.all_pixels,
+            ..JointOptions::new(self.paper.model, self.paper.seed)
+        }
+    }
+
+    /// One joint fit from `start` with `options`, its timings added under `label`; each
+    /// light's edge statuses from its uncertainty.
+    fn joint(
+        &self,
+        start: &[FittedLight],
+        options: &JointOptions,
+        label: &str,
+        found: &mut Found,
+    ) -> Result<()> {
+        let outcome = fit_joint(
+            self.scene,
+            self.photo,
+            self.water,
+            self.observations,
+            start,
+            options,
+        )?;
+        found.timings.extend(
+            outcome
+                .timings
+                .iter()
+                .map(|(stage, s)| (format!("{label} {stage}"), *s)),
+        );
+        found.lights = outcome
+            .lights
+            .iter()
+            .zip(&outcome.uncertainty)
+            .map(|(l, u)| FittedLight {
+                edges: joint::edge_statuses(l, u),
+                ..l.clone()
+            })
+            .collect();
+        found.uncertainties = outcome.uncertainty;
+        Ok(())
+    }
+
+    /// The joint fit from the paper's lights in `found`, then the refit of lights that share
+    /// a streak.
+    fn refine(&self, j: &JointSettings, found: &mut Found) -> Result<()> {
+        self.progress
+            .stage(&format!("joint fit of {} light(s)", found.lights.len()));
+        let start = std::mem::take(&mut found.lights);
+        let options = self.joint_options(j, j.reading);
+        self.joint(&start, &options, "joint", found)?;
+        self.refit_overlaps(&start, &options, j, found)
+    }
+
+    /// Fits the lights again from `start` with [`JointSettings::overlap_refit`] when the fit
+    /// in `found` ended with lights that share a streak.
+    fn refit_overlaps(
+        &self,
+        start: &[FittedLight],
+        options: &JointOptions,
+        j: &JointSettings,
+        found: &mut Found,
+    ) -> Result<()> {
+        let Some(reading) = j.overlap_refit else {
+            return Ok(());
+        };
+        if !warnings::shares_a_streak(&found.lights) {
+            return Ok(());
+        }
+        self.progress.stage(&format!(
+            "lights share a streak: joint fit again over {} with {} samples",
+            if reading.all_pixels {
+                "every pixel"
+            } else {
+                "a checkerboard half of the pixels"
+            },
+            reading.samples
+        ));
+        let refit = JointOptions {
+            samples: reading.samples,
+            checkerboard: !reading.all_pixels,
+            ..*options
+        };
+        found.reading = Some(reading);
+        self.joint(start, &refit, "joint refit of overlaps", found)
+    }
+
+    /// The joint fit with the gloss estimated first ([`GlossFit::Estimate`]).
+    fn with_gloss_search(&self, j: &JointSettings, found: &mut Found) -> Result<()> {
+        let GlossFit::Estimate(search) = &j.gloss else {
+            return Ok(());
+        };
+        self.progress.stage(&format!(
+            "gloss search and fit of {} streak(s) (each step a joint fit)",
+            self.observations.len()
+        ));
+        let final_fit = self.joint_options(j, j.reading);
+        let estimate = estimate_gloss(
+            self.scene,
+            self.photo,
+            self.water,
+            self.observations,
+            &self.paper,
+            &final_fit,
+            search,
+        )?;
+        found.gloss = (
+            estimate.gloss,
+            format!(
+                "estimated from the photo ({}, {} fits from e = {})",
+                Setting::GlossEstimate,
+                estimate.evaluations.len(),
+                self.scene.water.gloss
+            ),
+        );
+        found.lights = estimate.lights;
+        found.uncertainties = estimate.uncertainty;
+        found.skipped = estimate.skipped;
+        found.warnings.extend(estimate.warnings);
+        found.timings = estimate.timings;
+        let at_estimate = JointOptions {
+            model: ReflectionModel {
+                gloss: estimate.gloss,
+                ..final_fit.model
+            },
+            ..final_fit
+        };
+        self.refit_overlaps(&estimate.start, &at_estimate, j, found)
+    }
+}

@@ -1,0 +1,209 @@
+//! What a fit is asked to do, shaped so that no two settings can contradict each other: the
+//! method carries its own settings (the paper's estimate has no joint-fit settings; estimating
+//! the gloss is part of the joint fit's), and each value is held in one place.
+
+use crate::fitting::gloss::{GlossSearch, SEARCH_SAMPLES};
+use crate::fitting::joint::DEFAULT_JOINT_SAMPLES;
+use crate::fitting::DEFAULT_SAMPLES;
+use crate::optics::Shadowing;
+use crate::settings::Setting;
+use crate::streaks::StreakParams;
+use crate::{Error, Result};
+
+/// Everything [`super::fit`] needs besides the scene and the photo.
+#[derive(Clone, Debug)]
+pub struct FitSettings {
+    /// Lobe samples per traced pixel of the paper's estimate (method §5 steps 7-9). The edge
+    /// solutions average over tens of pixels, so a few hundred suffice.
+    pub samples: u32,
+    /// Seed of every random number of the fit: the same inputs and seed give the same lights.
+    pub seed: u64,
+    /// Shadowing term of the reflection model (method §4).
+    pub shadowing: Shadowing,
+    /// Settings of the streak extraction (method §5 steps 3-6).
+    pub streaks: StreakParams,
+    /// How the lights are fitted.
+    pub method: Method,
+}
+
+impl Default for FitSettings {
+    /// The defaults of `streaklight fit`: [`DEFAULT_SAMPLES`] samples, seed 1, the paper's
+    /// G = 1, the default streak extraction, the joint method with the scene's gloss.
+    fn default() -> Self {
+        FitSettings {
+            samples: DEFAULT_SAMPLES,
+            seed: 1,
+            shadowing: Shadowing::None,
+            streaks: StreakParams::default(),
+            method: Method::default(),
+        }
+    }
+}
+
+/// How the lights are fitted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    /// The paper's per-streak estimate alone, with streaklight's corrections (method §5).
+    Paper,
+    /// The paper's estimate, then every light refined together against every water pixel
+    /// from which it can be seen (render and compare), a light split in two where the
+    /// residual shows overlapping streaks, with per-parameter uncertainties.
+    Joint(JointSettings),
+}
+
+impl Default for Method {
+    /// The joint fit with its defaults.
+    fn default() -> Self {
+        Method::Joint(JointSettings::default())
+    }
+}
+
+impl Method {
+    /// "joint" or "paper".
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Joint(_) => "joint",
+            Method::Paper => "paper",
+        }
+    }
+}
+
+/// What a joint fit reads: its samples per pixel and which pixels of its region.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Reading {
+    /// Lobe samples per pixel, rounded by the fit to `8 b^2` (8, 32, 72, 128, ...;
+    /// [`crate::fitting::joint::effective_samples`]). The time grows with them and the fit's
+    /// own noise falls.
+    pub samples: u32,
+    /// Every pixel of the fitted region instead of a checkerboard half: about twice the time,
+    /// less of both the samples' and the photo's noise.
+    pub all_pixels: bool,
+}
+
+/// The reading lights that share a streak are fitted again with by default.
+pub const THOROUGH: Reading = Reading {
+    samples: 128,
+    all_pixels: true,
+};
+
+/// The settings of the joint fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointSettings {
+    /// What the fit reads.
+    pub reading: Reading,
+    /// When the fit ends with lights that share a streak (it split an overlapping streak),
+    /// fit again from the paper's estimate with this reading (`None`: keep the first fit).
+    /// The photo tells such lights apart only weakly; reading every pixel with more samples
+    /// halves their scatter on the bundled stacked samples, in about twice the time.
+    pub overlap_refit: Option<Reading>,
+    /// Independent fits, each from its own samples, whose mean is the result (at least 1):
+    /// N times slower, about sqrt(N) times less of the samples' noise, with the fits' spread
+    /// added to the uncertainties.
+    pub repeats: u32,
+    /// The water's gloss: the scene's, or estimated from the photo.
+    pub gloss: GlossFit,
+}
+
+impl Default for JointSettings {
+    /// [`DEFAULT_JOINT_SAMPLES`] samples over a checkerboard half of the pixels, lights that
+    /// share a streak fitted again with [`THOROUGH`], one repeat, the scene's gloss.
+    fn default() -> Self {
+        JointSettings {
+            reading: Reading {
+                samples: DEFAULT_JOINT_SAMPLES,
+                all_pixels: false,
+            },
+            overlap_refit: Some(THOROUGH),
+            repeats: 1,
+            gloss: GlossFit::Given,
+        }
+    }
+}
+
+impl JointSettings {
+    /// Estimating the gloss with the default search: the final fit reads [`SEARCH_SAMPLES`]
+    /// samples (the search's own; the cost is not to be trusted with fewer) over a
+    /// checkerboard, without a refit of lights that share a streak.
+    pub fn estimating_gloss() -> Self {
+        JointSettings {
+            reading: Reading {
+                samples: SEARCH_SAMPLES,
+                all_pixels: false,
+            },
+            overlap_refit: None,
+            repeats: 1,
+            gloss: GlossFit::Estimate(GlossSearch::default()),
+        }
+    }
+}
+
+/// Where the joint fit's gloss comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GlossFit {
+    /// The scene's (its material's, or the loader's override).
+    Given,
+    /// Estimated from the photo together with the lights, starting from the scene's
+    /// ([`crate::fitting::gloss`]): about 2-3 times the time of a fit.
+    Estimate(GlossSearch),
+}
+
+impl FitSettings {
+    /// Refuses values out of range, naming the setting.
+    pub fn validate(&self) -> Result<()> {
+        if self.samples == 0 {
+            return Err(Error::setting(Setting::Samples, "must be at least 1"));
+        }
+        if let Method::Joint(joint) = &self.method {
+            for reading in std::iter::once(&joint.reading).chain(&joint.overlap_refit) {
+                if reading.samples == 0 {
+                    return Err(Error::setting(Setting::JointSamples, "must be at least 1"));
+                }
+            }
+            if joint.repeats == 0 {
+                return Err(Error::setting(Setting::Repeats, "must be at least 1"));
+            }
+        }
+        self.streaks.seeds.validate()?;
+        self.streaks.grow.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zero_samples_are_refused_by_name() {
+        let no_samples = FitSettings {
+            samples: 0,
+            ..FitSettings::default()
+        };
+        let e = no_samples.validate().unwrap_err();
+        assert!(matches!(
+            e,
+            Error::Setting {
+                setting: Setting::Samples,
+                ..
+            }
+        ));
+        let mut joint = JointSettings::default();
+        joint.overlap_refit = Some(Reading {
+            samples: 0,
+            all_pixels: true,
+        });
+        let e = FitSettings {
+            method: Method::Joint(joint),
+            ..FitSettings::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.to_string(), "`Reading::samples` must be at least 1");
+        assert!(FitSettings::default().validate().is_ok());
+        assert!(FitSettings {
+            method: Method::Paper,
+            ..FitSettings::default()
+        }
+        .validate()
+        .is_ok());
+    }
+}
