@@ -4,7 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use streaklight::convert::{convert, ConvertOptions, Method};
+use streaklight::convert::{convert, ConvertOptions};
+use streaklight::pipeline::{FitSettings, Method};
 use streaklight::samples;
 use streaklight::scene_in::LoadOptions;
 
@@ -20,7 +21,7 @@ struct Case {
     paper: &'static str,
 }
 
-fn options(dir: &Path, case: &Case, method: Method) -> ConvertOptions {
+fn options(dir: &Path, case: &Case, method: Method) -> ConvertOptions<'static> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     ConvertOptions {
         load: LoadOptions {
@@ -28,7 +29,10 @@ fn options(dir: &Path, case: &Case, method: Method) -> ConvertOptions {
             ..Default::default()
         },
         exposure: samples::PHOTO_EXPOSURE,
-        method,
+        fit: FitSettings {
+            method,
+            ..FitSettings::default()
+        },
         ..ConvertOptions::new(
             dir.join(case.scene),
             root.join("samples").join(case.photo),
@@ -156,7 +160,7 @@ fn main() {
     println!("|---|---|---|---|---|---|---|");
     for (case, method) in cases
         .iter()
-        .flat_map(|c| [(c, Method::Paper), (c, Method::Joint)])
+        .flat_map(|c| [(c, Method::Paper), (c, Method::default())])
     {
         let result = convert(&options(&dir, case, method));
         let ours = match &result {

@@ -18,7 +18,9 @@
 
 use std::path::{Path, PathBuf};
 
-use streaklight::convert::{convert, ConvertOptions, Method};
+use streaklight::convert::{convert, ConvertOptions};
+use streaklight::pipeline::{FitSettings, JointSettings, Method};
+use streaklight::progress::Reporter;
 use streaklight::report::LightReport;
 use streaklight::samples::{self, SampleLight};
 use streaklight::scene_in::LoadOptions;
@@ -130,7 +132,7 @@ fn main() {
                 let lights = fit(
                     &dir,
                     &photo_path,
-                    FitSettings {
+                    BenchFit {
                         seed,
                         repeats: r,
                         joint_samples,
@@ -198,7 +200,7 @@ fn rendered(dir: &Path, photo: &str, spp: u32, cache: Option<&Path>) -> PathBuf 
         .find(|s| s.photo.as_deref() == Some(photo))
         .unwrap_or_else(|| panic!("{photo} is not a sample photo"));
     let t = std::time::Instant::now();
-    let image = samples::render_photo(dir, &spec, spp, false).expect("rendering the photo");
+    let image = samples::render_photo(dir, &spec, spp, Reporter::default()).expect("rendering the photo");
     if let Some(cache) = cache {
         std::fs::create_dir_all(cache).expect("creating SPREAD_RENDER_CACHE");
     }
@@ -218,7 +220,7 @@ fn distance(light: &LightReport, truth: &SampleLight) -> f64 {
 }
 
 /// The settings of one bench fit.
-struct FitSettings {
+struct BenchFit {
     seed: u64,
     repeats: u32,
     joint_samples: Option<u32>,
@@ -227,8 +229,8 @@ struct FitSettings {
 }
 
 /// `streaklight fit` of `photo` with `settings`: the report's lights.
-fn fit(dir: &Path, photo: &Path, settings: FitSettings) -> Vec<LightReport> {
-    let FitSettings {
+fn fit(dir: &Path, photo: &Path, settings: BenchFit) -> Vec<LightReport> {
+    let BenchFit {
         seed,
         repeats,
         joint_samples,
@@ -241,11 +243,14 @@ fn fit(dir: &Path, photo: &Path, settings: FitSettings) -> Vec<LightReport> {
             ..Default::default()
         },
         exposure: samples::PHOTO_EXPOSURE,
-        method: Method::Joint,
-        seed,
-        repeats,
-        joint_samples,
-        all_pixels,
+        fit: FitSettings {
+            seed,
+            method: Method::Joint(JointSettings {
+                repeats,
+                ..JointSettings::default().reading_chosen(joint_samples, all_pixels)
+            }),
+            ..FitSettings::default()
+        },
         ..ConvertOptions::new(
             dir.join("scene.gltf"),
             photo,

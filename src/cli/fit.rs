@@ -94,20 +94,14 @@ impl Args {
             }
             Method::Paper
         } else {
-            let mut joint = match self.gloss {
+            let joint = match self.gloss {
                 Some(GlossArg::Auto) => JointSettings::estimating_gloss(),
                 _ => JointSettings::default(),
             };
-            joint.repeats = self.repeats;
-            if self.joint_samples.is_some() || self.all_pixels {
-                // The user chose what the fit reads: that choice stands for every light.
-                joint.overlap_refit = None;
-            }
-            if let Some(samples) = self.joint_samples {
-                joint.reading.samples = samples;
-            }
-            joint.reading.all_pixels |= self.all_pixels;
-            Method::Joint(joint)
+            Method::Joint(JointSettings {
+                repeats: self.repeats,
+                ..joint.reading_chosen(self.joint_samples, self.all_pixels)
+            })
         };
         Ok(FitSettings {
             samples: self.samples,

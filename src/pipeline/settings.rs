@@ -137,6 +137,22 @@ impl JointSettings {
     }
 }
 
+impl JointSettings {
+    /// These settings with what the fit reads chosen by the user: `samples` (when given)
+    /// and every pixel (when `all_pixels`). A choice made stands for every light: when either
+    /// is given, lights that share a streak are not fitted again with another reading.
+    pub fn reading_chosen(mut self, samples: Option<u32>, all_pixels: bool) -> Self {
+        if samples.is_some() || all_pixels {
+            self.overlap_refit = None;
+        }
+        if let Some(samples) = samples {
+            self.reading.samples = samples;
+        }
+        self.reading.all_pixels |= all_pixels;
+        self
+    }
+}
+
 /// Where the joint fit's gloss comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum GlossFit {
