@@ -245,18 +245,13 @@ fn uniform_water(photo: &Photo, water: &[bool]) -> Option<String> {
     })
 }
 
-/// A streak as the fitters take it: its id and pixels, and the photo width they index.
+/// A streak as the fitters take it: its id, pixels and edges, and the photo width they index.
 pub fn observation(streak: &streaks::Streak, width: u32) -> StreakObservation {
     StreakObservation {
         id: streak.id,
         pixels: streak.pixels.clone(),
         brightest: streak.brightest.1 * width + streak.brightest.0,
-        edges: [
-            streak.edges.left.clone(),
-            streak.edges.right.clone(),
-            streak.edges.top.clone(),
-            streak.edges.bottom.clone(),
-        ],
+        edges: streak.edges.clone(),
     }
 }
 
