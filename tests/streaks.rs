@@ -14,7 +14,7 @@ use streaklight::photo_in::{self, Photo};
 use streaklight::random::Rng;
 use streaklight::samples::{self, SampleLight};
 use streaklight::scene_in::{self, LoadOptions, Scene};
-use streaklight::streaks::{extract_streaks, BoundingBox, Segmentation, StreakParams};
+use streaklight::streaks::{extract_streaks, BoundingBox, Segmentation, StreakParams, StreakSide};
 use streaklight::water_mask::water_mask;
 
 struct Setup {
@@ -125,12 +125,7 @@ fn check_matches(seg: &Segmentation, lights: &[SampleLight]) {
             .count();
         assert!(inside as f64 >= 0.9 * streak.pixels.len() as f64);
         assert!(streak.pixels.len() > 1000);
-        for side in [
-            &streak.edges.left,
-            &streak.edges.right,
-            &streak.edges.top,
-            &streak.edges.bottom,
-        ] {
+        for side in StreakSide::ALL.map(|s| &streak.edges[s]) {
             assert!(!side.is_empty());
         }
     }

@@ -23,8 +23,8 @@ pub struct EdgeEstimate {
 
 /// Which light edge the pixel's footprint constrains: the edge beyond which its lobe's centre
 /// lands, measured in units of the rectangle's half sizes (so a long light does not claim every
-/// pixel for its short sides). The paper maps streak sides to light sides once and for all;
-/// with waves a streak's top pixel can look past a light's side edge, so this decides per
+/// pixel for its short sides). The paper maps streak sides to light sides once and for all
+/// ([`EdgeSide::streak_side`], which the first rectangle still uses); with waves a streak's top pixel can look past a light's side edge, so this decides per
 /// pixel. A dim pixel centred inside the rectangle goes to the nearest edge: it says that
 /// edge is too far out (an initial rectangle that is too large must be able to shrink). `None`
 /// for a footprint with no sample on the plane.

@@ -72,6 +72,11 @@ impl FitOptions {
 pub const DEFAULT_SAMPLES: u32 = 512;
 
 /// An edge of the light's rectangle (of the light, not of the streak).
+///
+/// An array of four indexed by `EdgeSide` (`array[EdgeSide::Top]`) is one value per edge in
+/// the order Left, Right, Bottom, Top: the order of [`EdgeSide::ALL`], of [`Rect`]'s fields and
+/// of the reports. [`StreakSide`] (a side of the streak in the image) has the same order; the
+/// two meet only in [`EdgeSide::streak_side`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum EdgeSide {
     /// Smallest u.
@@ -85,7 +90,7 @@ pub enum EdgeSide {
 }
 
 impl EdgeSide {
-    /// All four, in the order of [`FittedLight::edges`].
+    /// All four, in the order of arrays indexed by edge ([`FittedLight::edges`]).
     pub const ALL: [EdgeSide; 4] = [
         EdgeSide::Left,
         EdgeSide::Right,
@@ -101,6 +106,44 @@ impl EdgeSide {
             EdgeSide::Bottom => "bottom",
             EdgeSide::Top => "top",
         }
+    }
+
+    /// True for the left and right edges (positions along `u`), false for bottom and top
+    /// (along `v`).
+    pub fn along_u(self) -> bool {
+        matches!(self, EdgeSide::Left | EdgeSide::Right)
+    }
+
+    /// True for the left and bottom edges (the smaller coordinate), false for right and top.
+    pub fn is_min(self) -> bool {
+        matches!(self, EdgeSide::Left | EdgeSide::Bottom)
+    }
+
+    /// The side of the streak that shows this edge in the paper's fixed mapping: left to
+    /// left, right to right, and, the reflection flipping the vertical order, the light's
+    /// bottom edge on the streak's top side and its top edge on the streak's bottom side.
+    /// Only the first rectangle uses it; the fit then assigns each edge pixel to an edge by
+    /// where its lobe lands ([`edges::assign`]).
+    pub fn streak_side(self) -> StreakSide {
+        match self {
+            EdgeSide::Left => StreakSide::Left,
+            EdgeSide::Right => StreakSide::Right,
+            EdgeSide::Bottom => StreakSide::Top,
+            EdgeSide::Top => StreakSide::Bottom,
+        }
+    }
+}
+
+impl<T> std::ops::Index<EdgeSide> for [T; 4] {
+    type Output = T;
+    fn index(&self, side: EdgeSide) -> &T {
+        &self[side as usize]
+    }
+}
+
+impl<T> std::ops::IndexMut<EdgeSide> for [T; 4] {
+    fn index_mut(&mut self, side: EdgeSide) -> &mut T {
+        &mut self[side as usize]
     }
 }
 
@@ -143,7 +186,7 @@ pub struct FittedLight {
     pub v_max: f32,
     /// Linear RGB radiance (the photo's units, after exposure), emitted along `plane.normal`.
     pub radiance: [f32; 3],
-    /// Status of the left, right, bottom and top edges (indexed by [`EdgeSide`]).
+    /// Status of each edge, indexed by [`EdgeSide`] (left, right, bottom, top).
     pub edges: [EdgeStatus; 4],
 }
 

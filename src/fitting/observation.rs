@@ -1,5 +1,8 @@
-//! The fitter's input: one streak (or streak fragment) as pixel sets, and the streak-edge rule
-//! of METHOD §5 step 6.
+//! The fitter's input: one streak (or streak fragment) as pixel sets.
+
+pub use crate::streaks::{StreakEdges, StreakSide};
+
+use crate::streaks::edges::streak_edges;
 
 /// One streak of the photo, as the streak extraction hands it to the fitter.
 ///
@@ -13,49 +16,17 @@ pub struct StreakObservation {
     /// The brightest pixel of the streak's brightest superpixel: where the light plane is
     /// searched (METHOD §5 step 7).
     pub brightest: u32,
-    /// Edge pixels of the streak on its left, right, top and bottom sides in the image
-    /// (METHOD §5 step 6), in that order; see [`StreakSide`].
-    pub edges: [Vec<u32>; 4],
-}
-
-/// A side of a streak in the image (not of the light: a reflection flips top and bottom).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StreakSide {
-    /// Towards column 0.
-    Left = 0,
-    /// Towards the last column.
-    Right = 1,
-    /// Towards row 0.
-    Top = 2,
-    /// Towards the last row.
-    Bottom = 3,
-}
-
-impl StreakSide {
-    /// All four, in the order of [`StreakObservation::edges`].
-    pub const ALL: [StreakSide; 4] = [
-        StreakSide::Left,
-        StreakSide::Right,
-        StreakSide::Top,
-        StreakSide::Bottom,
-    ];
-
-    /// The three neighbour offsets (dx, dy) on this side of a pixel in its 3 x 3.
-    pub fn outward_neighbours(self) -> [(i32, i32); 3] {
-        match self {
-            StreakSide::Left => [(-1, -1), (-1, 0), (-1, 1)],
-            StreakSide::Right => [(1, -1), (1, 0), (1, 1)],
-            StreakSide::Top => [(-1, -1), (0, -1), (1, -1)],
-            StreakSide::Bottom => [(-1, 1), (0, 1), (1, 1)],
-        }
-    }
+    /// Edge pixels of the streak on each of its sides in the image (METHOD §5 step 6),
+    /// indexed by [`StreakSide`].
+    pub edges: StreakEdges,
 }
 
 impl StreakObservation {
-    /// Builds an observation from a streak's pixels: the edge pixels by METHOD §5 step 6 (a
-    /// pixel is a left-edge pixel when none of its three left neighbours belongs to the
-    /// streak; outside the image counts as not belonging), and the brightest pixel by the
-    /// luminance of `radiance` (the streak extraction picks it per superpixel instead).
+    /// Builds an observation from a streak's pixels: the edge pixels by METHOD §5 step 6
+    /// ([`crate::streaks::edges::streak_edges`], as the extraction finds them), and the
+    /// brightest pixel by the luminance of `radiance` (the streak extraction picks it per
+    /// superpixel instead). The pixels are sorted, so every side lists its pixels in raster
+    /// order.
     ///
     /// Returns `None` when `pixels` is empty or holds an index outside the image.
     pub fn from_pixels(
@@ -75,16 +46,8 @@ impl StreakObservation {
         for &p in &pixels {
             member[p as usize] = true;
         }
-        let edges = StreakSide::ALL.map(|side| {
-            pixels
-                .iter()
-                .copied()
-                .filter(|&p| {
-                    side.outward_neighbours().iter().all(|&(dx, dy)| {
-                        neighbour(p, dx, dy, width, height).is_none_or(|q| !member[q as usize])
-                    })
-                })
-                .collect()
+        let edges = streak_edges(width, height, &pixels, |x, y| {
+            member[(y * width + x) as usize]
         });
         let brightest = pixels.iter().copied().max_by(|&a, &b| {
             luminance(radiance[a as usize]).total_cmp(&luminance(radiance[b as usize]))

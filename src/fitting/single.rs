@@ -41,7 +41,7 @@ struct EdgePixel {
     /// The streak continues past the photo's border or the water's end here: the pixel is
     /// not on the streak's real edge.
     truncated: bool,
-    /// The streak sides it is an edge pixel of (indexed by [`StreakSide`]).
+    /// Whether it is an edge pixel of each side of the streak (indexed by [`StreakSide`]).
     sides: [bool; 4],
 }
 
@@ -86,8 +86,8 @@ pub fn fit_streak(
 
     // Pixels to trace: every streak-edge pixel and the brightest interior ones.
     let mut edge_pixels: Vec<(u32, bool, [bool; 4])> = Vec::new();
-    for (side, pixels) in StreakSide::ALL.iter().zip(&obs.edges) {
-        for &p in pixels {
+    for side in StreakSide::ALL {
+        for &p in &obs.edges[side] {
             if p as usize >= photo.clipped.len() || photo.clipped[p as usize] {
                 continue;
             }
@@ -96,7 +96,7 @@ pub fn fit_streak(
                     .is_none_or(|q| !water.get(q as usize).copied().unwrap_or(false))
             });
             let mut sides = [false; 4];
-            sides[*side as usize] = true;
+            sides[side] = true;
             edge_pixels.push((p, truncated, sides));
         }
     }
@@ -105,8 +105,8 @@ pub fn fit_streak(
     edge_pixels.dedup_by(|b, a| {
         if a.0 == b.0 {
             a.1 |= b.1;
-            for k in 0..4 {
-                a.2[k] |= b.2[k];
+            for side in StreakSide::ALL {
+                a.2[side] |= b.2[side];
             }
             true
         } else {
@@ -244,14 +244,14 @@ fn solve(
         let mut fitted = [false; 4];
         for e in edges {
             if let Some(side) = assign(&fps[e.footprint], &rect) {
-                assigned[side as usize].push(e);
+                assigned[side].push(e);
             }
         }
         for side in EdgeSide::ALL {
-            let pixels = &assigned[side as usize];
+            let pixels = &assigned[side];
             let truncated = pixels.iter().filter(|e| e.truncated).count();
             let valid = pixels.len() - truncated;
-            status[side as usize] = if valid < MIN_EDGE_PIXELS {
+            status[side] = if valid < MIN_EDGE_PIXELS {
                 EdgeStatus::Unconstrained {
                     reason: format!(
                         "only {valid} streak-edge pixels constrain the light's {} edge",
@@ -273,14 +273,14 @@ fn solve(
             } else {
                 EdgeStatus::Constrained { pixels: valid }
             };
-            fitted[side as usize] = valid >= MIN_EDGE_PIXELS;
+            fitted[side] = valid >= MIN_EDGE_PIXELS;
         }
         // An edge no valid pixel constrains is placed as far as any traced pixel can see, so
         // that it does not cut the other pixels' lobes short. `rect` keeps the last estimate,
         // against which pixels are assigned, so that such an edge can still collect pixels.
         let modelled = |rect: &Rect, fitted: &[bool; 4]| {
             EdgeSide::ALL.iter().fold(*rect, |r, &s| {
-                if fitted[s as usize] {
+                if fitted[s] {
                     r
                 } else {
                     r.with_edge(s, far.edge(s))
@@ -288,11 +288,11 @@ fn solve(
             })
         };
         for side in EdgeSide::ALL {
-            if !fitted[side as usize] {
+            if !fitted[side] {
                 continue;
             }
             let model = modelled(&rect, &fitted);
-            let estimates: Vec<EdgeEstimate> = assigned[side as usize]
+            let estimates: Vec<EdgeEstimate> = assigned[side]
                 .iter()
                 // Pixels where the streak is cut are not on its edge: solving them as edge
                 // pixels pulls the edge in (tried: light1 of Table 3 came out 0.6 m short).
@@ -327,7 +327,7 @@ fn solve(
         }
     }
     let model = EdgeSide::ALL.iter().fold(rect, |r, &s| {
-        if last_fitted[s as usize] {
+        if last_fitted[s] {
             r
         } else {
             r.with_edge(s, far.edge(s))
@@ -353,21 +353,13 @@ fn plausible(fit: &Solution) -> bool {
         && peak(fit.radiance) < 5.0 * peak(fit.initial_radiance)
 }
 
-/// A first rectangle, larger than the light: on each side of the streak, a far percentile of
-/// where that side's edge pixels' lobes are centred, with the paper's mapping of streak sides
-/// to light sides (left to left, right to right, and the reflection's flip: the streak's top
-/// to the light's bottom). Edge pixels are dim, so their lobes are centred outside the light:
-/// the first pass sees every real edge pixel outside the rectangle, where the per-pixel
-/// assignment needs it.
+/// A first rectangle, larger than the light: each edge at a far percentile of where the edge
+/// pixels of the streak side showing it have their lobes centred, with the paper's mapping of
+/// streak sides to light edges ([`EdgeSide::streak_side`]: the reflection's flip puts the
+/// light's bottom edge on the streak's top side). Edge pixels are dim, so their lobes are
+/// centred outside the light: the first pass sees every real edge pixel outside the rectangle,
+/// where the per-pixel assignment needs it.
 fn initial_rect(fps: &[Footprint], edges: &[EdgePixel]) -> Option<Rect> {
-    let side_values = |side: StreakSide, along_u: bool| -> Vec<f32> {
-        edges
-            .iter()
-            .filter(|e| e.sides[side as usize])
-            .filter_map(|e| fps[e.footprint].centroid())
-            .map(|c| if along_u { c.x } else { c.y })
-            .collect()
-    };
     let pct = |mut xs: Vec<f32>, q: f32| -> Option<f32> {
         if xs.is_empty() {
             return None;
@@ -379,13 +371,28 @@ fn initial_rect(fps: &[Footprint], edges: &[EdgePixel]) -> Option<Rect> {
         .iter()
         .filter_map(|e| fps[e.footprint].centroid())
         .collect();
-    let all_u: Vec<f32> = all.iter().map(|c| c.x).collect();
-    let all_v: Vec<f32> = all.iter().map(|c| c.y).collect();
+    // From the side's pixels, or from every edge pixel (a nearer percentile) when the side
+    // has none.
+    let edge = |side: EdgeSide| -> Option<f32> {
+        let along = |c: glam::Vec2| if side.along_u() { c.x } else { c.y };
+        let (q_side, q_all) = if side.is_min() {
+            (0.1, 0.03)
+        } else {
+            (0.9, 0.97)
+        };
+        let shown: Vec<f32> = edges
+            .iter()
+            .filter(|e| e.sides[side.streak_side()])
+            .filter_map(|e| fps[e.footprint].centroid())
+            .map(along)
+            .collect();
+        pct(shown, q_side).or_else(|| pct(all.iter().copied().map(along).collect(), q_all))
+    };
     let mut r = Rect {
-        u_min: pct(side_values(StreakSide::Left, true), 0.1).or(pct(all_u.clone(), 0.03))?,
-        u_max: pct(side_values(StreakSide::Right, true), 0.9).or(pct(all_u, 0.97))?,
-        v_min: pct(side_values(StreakSide::Top, false), 0.1).or(pct(all_v.clone(), 0.03))?,
-        v_max: pct(side_values(StreakSide::Bottom, false), 0.9).or(pct(all_v, 0.97))?,
+        u_min: edge(EdgeSide::Left)?,
+        u_max: edge(EdgeSide::Right)?,
+        v_min: edge(EdgeSide::Bottom)?,
+        v_max: edge(EdgeSide::Top)?,
     };
     if r.u_min > r.u_max {
         (r.u_min, r.u_max) = (r.u_max, r.u_min);

@@ -79,12 +79,7 @@ pub fn observation(streak: &streaks::Streak, width: u32) -> StreakObservation {
         id: streak.id,
         pixels: streak.pixels.clone(),
         brightest: streak.brightest.1 * width + streak.brightest.0,
-        edges: [
-            streak.edges.left.clone(),
-            streak.edges.right.clone(),
-            streak.edges.top.clone(),
-            streak.edges.bottom.clone(),
-        ],
+        edges: streak.edges.clone(),
     }
 }
 

@@ -5,7 +5,7 @@ use super::{
     Timing, UncertaintyReport, REPORT_VERSION,
 };
 use crate::fitting::joint::{effective_samples, Uncertainty};
-use crate::fitting::{EdgeStatus, FittedLight, Skipped};
+use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, Skipped};
 use crate::optics::Shadowing;
 use crate::pipeline::{light_name, FitSettings, Lit, Method};
 use crate::scene_in::Scene;
@@ -107,12 +107,12 @@ fn uncertainty_report(u: &Uncertainty) -> Option<UncertaintyReport> {
     if !u.radiance.iter().all(|r| r.is_finite()) {
         return None;
     }
-    let e = |i: usize| u.edges[i].filter(|s| s.is_finite()).map(f64::from);
+    let e = |side: EdgeSide| u.edges[side].filter(|s| s.is_finite()).map(f64::from);
     Some(UncertaintyReport {
-        left: e(0),
-        right: e(1),
-        bottom: e(2),
-        top: e(3),
+        left: e(EdgeSide::Left),
+        right: e(EdgeSide::Right),
+        bottom: e(EdgeSide::Bottom),
+        top: e(EdgeSide::Top),
         radiance: u.radiance.map(f64::from),
     })
 }
@@ -144,10 +144,10 @@ pub fn light_report(
         height: light.height() as f64,
         radiance,
         edges: EdgesReport {
-            left: edge_report(&light.edges[0]),
-            right: edge_report(&light.edges[1]),
-            bottom: edge_report(&light.edges[2]),
-            top: edge_report(&light.edges[3]),
+            left: edge_report(&light.edges[EdgeSide::Left]),
+            right: edge_report(&light.edges[EdgeSide::Right]),
+            bottom: edge_report(&light.edges[EdgeSide::Bottom]),
+            top: edge_report(&light.edges[EdgeSide::Top]),
         },
         uncertainty: uncertainty.and_then(uncertainty_report),
         light_index: None,

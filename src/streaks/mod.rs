@@ -18,7 +18,7 @@ pub mod report;
 pub mod seeds;
 pub mod superpixels;
 
-pub use edges::StreakEdges;
+pub use edges::{StreakEdges, StreakSide};
 pub use growing::GrowParams;
 pub use seeds::{SeedParams, SeedPoint};
 pub use superpixels::{SlicParams, Superpixels};
@@ -76,7 +76,7 @@ pub struct Streak {
     pub brightest: (u32, u32),
     /// Mean linear radiance (RGB) of its pixels.
     pub mean_colour: [f32; 3],
-    /// Its edge pixels by side.
+    /// Its edge pixels by side (indexed by [`StreakSide`]), in raster order.
     pub edges: StreakEdges,
 }
 
@@ -213,7 +213,8 @@ pub fn extract_streaks(
         }
     }
     for s in streaks.iter_mut() {
-        s.edges = edges::streak_edges(w, h, &owner, s.id as u32, &s.pixels);
+        let id = s.id as u32;
+        s.edges = edges::streak_edges(w, h, &s.pixels, |x, y| owner[(y * w + x) as usize] == id);
     }
     let max_water_value = value
         .iter()

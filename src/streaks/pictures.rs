@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
 
-use super::Segmentation;
+use super::{Segmentation, StreakSide};
 use crate::output_file::write_atomically;
 use crate::photo_in::Photo;
 use crate::{Error, Result};
@@ -133,14 +133,15 @@ pub fn streaks_picture(photo: &Photo, water: &[bool], seg: &Segmentation) -> Rgb
 pub fn edges_picture(photo: &Photo, seg: &Segmentation) -> RgbImage {
     let mut img = base(photo, 0.4);
     for s in &seg.streaks {
-        let sides: [(&[u32], [u8; 3]); 4] = [
-            (&s.edges.top, [60, 60, 255]),
-            (&s.edges.bottom, [255, 230, 0]),
-            (&s.edges.left, [255, 40, 40]),
-            (&s.edges.right, [40, 255, 40]),
+        // Drawn in this order: a pixel on several sides takes the last one's colour.
+        let sides = [
+            (StreakSide::Top, [60, 60, 255]),
+            (StreakSide::Bottom, [255, 230, 0]),
+            (StreakSide::Left, [255, 40, 40]),
+            (StreakSide::Right, [40, 255, 40]),
         ];
-        for (pixels, c) in sides {
-            for &p in pixels {
+        for (side, c) in sides {
+            for &p in &s.edges[side] {
                 img.put_pixel(p % photo.width, p / photo.width, Rgb(c));
             }
         }

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::{BoundingBox, Segmentation, StreakParams};
+use super::{BoundingBox, Segmentation, StreakParams, StreakSide};
 use crate::output_file::write_atomically;
 use crate::{Error, Result};
 
@@ -159,10 +159,10 @@ pub fn report(seg: &Segmentation, params: &StreakParams) -> Report {
                 },
                 mean_colour: s.mean_colour,
                 edge_pixel_counts: EdgeCounts {
-                    left: s.edges.left.len(),
-                    right: s.edges.right.len(),
-                    top: s.edges.top.len(),
-                    bottom: s.edges.bottom.len(),
+                    left: s.edges[StreakSide::Left].len(),
+                    right: s.edges[StreakSide::Right].len(),
+                    top: s.edges[StreakSide::Top].len(),
+                    bottom: s.edges[StreakSide::Bottom].len(),
                 },
             })
             .collect(),
