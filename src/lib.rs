@@ -31,5 +31,6 @@ pub mod scene_out;
 pub mod streaks;
 pub mod tracing;
 pub mod water_mask;
+pub mod water_model;
 
 pub use error::{Error, Result};
