@@ -6,7 +6,7 @@
 //! squares solve per channel ([`Problem::solve_radiance`]). A clipped pixel only counts when
 //! the model is below it (it is a lower bound, METHOD §2).
 //!
-//! The noise of the coefficients, and why the fit must remove it.
+//! # The noise of the coefficients, and why the fit must remove it
 //!
 //! The coefficients are Monte Carlo estimates, and least squares with a noisy regressor is
 //! biased: sum c_hat^2 overestimates sum c^2 by the summed variance, which pulls the radiance
@@ -54,6 +54,7 @@ impl Problem {
         st
     }
 
+    /// The modelled pixel i, per channel: every light's radiance times its coefficient.
     pub(super) fn model(&self, st: &State, i: usize) -> [f64; 3] {
         let mut m = [0.0; 3];
         for (k, l) in st.radiance.iter().enumerate() {

@@ -112,7 +112,7 @@ pub(super) const KERNEL_SCALE: f32 = 0.5;
 /// The fraction of the interval `[x - h, x + h]` inside `[lo, hi]` (for `h = 0`, whether `x`
 /// is inside).
 #[inline]
-pub(super) fn coverage(x: f32, h: f32, lo: f32, hi: f32) -> f32 {
+fn coverage(x: f32, h: f32, lo: f32, hi: f32) -> f32 {
     let (a, b) = (x - h, x + h);
     // Most intervals are wholly inside or outside: no division for those.
     if a >= lo && b <= hi {

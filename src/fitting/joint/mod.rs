@@ -11,21 +11,21 @@
 //! METHOD §2). The fitted region is the streaks, dilated, plus every pixel near them whose
 //! reflected rays can reach a light's region of interest: a streak's faint ends fall below
 //! any segmentation's threshold, and an edge seen only through them would otherwise drift
-//! ([`region`]).
+//! (`region`).
 //!
 //! Each pixel's coefficient is integrated over its footprint as the renderer does it (the
 //! forward model is a [`WaterModel`], by default the exact surface the renderer uses):
 //! stratified jittered camera rays, each with a stratified set of lobe samples, in two
 //! independent halves whose difference measures the estimate's noise. The samples that land
-//! on each light's plane inside its region of interest are traced ONCE ([`samples`]);
+//! on each light's plane inside its region of interest are traced ONCE (`samples`);
 //! afterwards `c_k(p; rect)` for any rectangle is a sum over stored samples, so the
 //! optimisation traces no ray. Each sample spreads its weight over a small kernel sized by its
-//! lobe cell, so that a coefficient changes smoothly with the rectangle's edges ([`kernel`]).
+//! lobe cell, so that a coefficient changes smoothly with the rectangle's edges (`kernel`).
 //! The stored samples are common random numbers across all parameter values, so the cost is
 //! a deterministic function of the rectangles, and the coefficients' own noise is removed
-//! from it ([`cost`]).
+//! from it (`cost`).
 //!
-//! What noise is left is cut by a control variate ([`control_variate`]): per pixel a
+//! What noise is left is cut by a control variate (`control_variate`): per pixel a
 //! Gaussian on the light's plane, matched to the pixel's lobe, whose mass inside a rectangle
 //! is known in closed form. Each stored sample carries only its weight less the Gaussian's
 //! (so an edge cutting through the samples moves the estimate by far less noise), and the
@@ -35,9 +35,9 @@
 //! (BENCHMARKS.md).
 //!
 //! The model is linear in the radiances: given the rectangles they are a nonnegative least
-//! squares solve per channel ([`cost`]). The edges are found by coordinate descent
-//! ([`descent`]) where each 1D step evaluates the cost on a whole grid of edge positions in
-//! one pass over the samples (prefix sums over binned samples: [`ramps`], [`profile`]), with
+//! squares solve per channel (`cost`). The edges are found by coordinate descent
+//! (`descent`) where each 1D step evaluates the cost on a whole grid of edge positions in
+//! one pass over the samples (prefix sums over binned samples: `ramps`, `profile`), with
 //! that light's radiance re-optimised in closed form at every grid point, so a far-off start
 //! (the paper's estimate can be metres off) is pulled in by a global 1D search rather than a
 //! local step. The grid then shrinks around the best position until it is finer than a
@@ -46,30 +46,30 @@
 //!
 //! Overlapping streaks (two lights whose reflections merge into one region, the paper's
 //! §5.3): when the residual of a fit is structured along the image rows, each light is tried
-//! as two (one above the other, or side by side: [`split`]), and the split is kept when it
+//! as two (one above the other, or side by side: `split`), and the split is kept when it
 //! removes most of that structure. The second light of a split then reads a sample set of
 //! its own, drawn independently on the same plane, and the boundary between the two is
-//! searched globally before the final descent ([`boundary`]; the sequence: [`optimise`]).
+//! searched globally before the final descent (`boundary`; the sequence: `optimise`).
 //!
-//! Independent repeats are averaged ([`repeats`]); the uncertainties come from the curvature
-//! of the cost the fit minimises ([`uncertainty`]).
+//! Independent repeats are averaged (`repeats`); the uncertainties come from the curvature
+//! of the cost the fit minimises (`uncertainty`).
 //!
 //! | file | what |
 //! |---|---|
 //! | `mod.rs` | options, outcome, [`fit_joint`] |
-//! | [`region`] | the fitted pixels, each light's region of interest |
-//! | [`samples`] | tracing and storing the plane samples, a coefficient from them |
-//! | [`kernel`] | each sample's cell and kernel |
-//! | [`control_variate`] | the lobe Gaussian |
-//! | [`problem`] | the fitted pixels with their samples, a fit's state |
-//! | [`cost`] | the cost, the coefficients' noise, the radiances' solve |
-//! | [`ramps`] | a coefficient at every grid position of one edge |
-//! | [`profile`] | the cost at every grid position of one edge |
-//! | [`descent`] | coordinate descent and its windows |
-//! | [`optimise`] | descent, split, boundary search, descent; repeats' replay |
-//! | [`split`], [`boundary`] | overlapping streaks: the cut, the boundary search |
-//! | [`repeats`] | the mean of repeated fits and its standard error |
-//! | [`uncertainty`] | uncertainties, facing edges, edge statuses |
+//! | `region` | the fitted pixels, each light's region of interest |
+//! | `samples` | tracing and storing the plane samples, a coefficient from them |
+//! | `kernel` | each sample's cell and kernel |
+//! | `control_variate` | the lobe Gaussian |
+//! | `problem` | the fitted pixels with their samples, a fit's state |
+//! | `cost` | the cost, the coefficients' noise, the radiances' solve |
+//! | `ramps` | a coefficient at every grid position of one edge |
+//! | `profile` | the cost at every grid position of one edge |
+//! | `descent` | coordinate descent and its windows |
+//! | `optimise` | descent, split, boundary search, descent; repeats' replay |
+//! | `split`, `boundary` | overlapping streaks: the cut, the boundary search |
+//! | `repeats` | the mean of repeated fits and its standard error |
+//! | `uncertainty` | uncertainties, facing edges, edge statuses |
 
 use std::time::Instant;
 

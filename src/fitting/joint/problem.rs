@@ -40,7 +40,8 @@ pub(super) struct State {
     pub(super) radiance: Vec<[f64; 3]>,
     /// `coef[k][i]`: light k's coefficient at fitted pixel i with the current rectangle.
     pub(super) coef: Vec<Vec<f32>>,
-    /// `dev[k][i]`: that estimate's half-difference (see the note on the coefficients' noise in [`super::cost`]).
+    /// `dev[k][i]`: that estimate's half-difference (see the note on the coefficients' noise
+    /// in [`super::cost`]).
     pub(super) dev: Vec<Vec<f32>>,
 }
 

@@ -36,12 +36,13 @@ pub(super) const JOINT_STREAM: u64 = 3 << 48;
 pub(super) struct PlaneSamples {
     /// Per pixel, where its samples start (and, at `i + 1`, end) in the per-sample vectors.
     pub(super) offsets: Vec<u32>,
-    /// Per pixel, the bounding box of its samples' cells (empty pixels: an inverted box).
+    /// Per pixel, the bounding box of its samples' kernels ([`Rect::EMPTY`] for a pixel with
+    /// none).
     pub(super) bbox: Vec<Rect>,
     /// Per sample, where it lands (plane coordinates).
     pub(super) points: Vec<Vec2>,
     /// Per sample, the half-widths of its kernel along the plane's axes (see
-    /// [`cell_half_extents`] and the note on the cells).
+    /// [`cell_half_extents`] and [`super::kernel`]).
     pub(super) cells: Vec<Vec2>,
     /// Per sample, its weight less the control variate's (see [`super::control_variate`]):
     /// negative where the Gaussian outweighs the lobe.
@@ -60,7 +61,8 @@ impl PlaneSamples {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
     }
 
-    /// `(c, d)`: the coefficient and its half-difference (see the note on the coefficients' noise).
+    /// Pixel i's `(c, d)` for `rect`: the coefficient and its half-difference (see the note
+    /// on the coefficients' noise in [`super::cost`]).
     pub(super) fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> (f32, f32) {
         let r = self.range(i);
         let (mut sum, mut signed) = (0f32, 0f32);

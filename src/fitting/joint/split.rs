@@ -1,5 +1,5 @@
 //! Overlapping streaks, METHOD §5 and the paper's §5.3: whether one light is better
-//! explained as two, and which way to cut it (see [`super::optimise`]). Where the two lights
+//! explained as two, and which way to cut it (see [`super::optimise`](mod@super::optimise)). Where the two lights
 //! meet is [`super::boundary`]'s work.
 
 use super::problem::{Problem, State};
