@@ -69,5 +69,6 @@ pub mod settings;
 pub mod streaks;
 pub mod tracing;
 pub mod water_mask;
+pub mod water_model;
 
 pub use error::{Error, Result};

@@ -12,6 +12,7 @@ use crate::optics::ReflectionModel;
 use crate::random::Rng;
 use crate::scene_in::Scene;
 use crate::tracing::Hit;
+use crate::water_model::{ExactSurface, WaterModel};
 
 /// Stream tag of the footprints' random numbers: distinct from the renderer's (which uses the
 /// bare pixel index), so a fit of a photo rendered with the same seed does not reuse the
@@ -91,11 +92,12 @@ impl Footprint {
 }
 
 /// Computes the footprints of `probes` (centre pixel, box radius) on `plane`, `samples` lobe
-/// samples each, in parallel.
-#[allow(clippy::too_many_arguments)]
+/// samples each, in parallel, the water as `water_model` has it.
 /// Each pixel draws from its own random stream (seed, pixel), so the result does not depend on
 /// the number of threads.
+#[allow(clippy::too_many_arguments)]
 pub fn footprints(
+    water_model: &dyn WaterModel,
     scene: &Scene,
     model: &ReflectionModel,
     plane: &LightPlane,
@@ -108,7 +110,8 @@ pub fn footprints(
     probes
         .par_iter()
         .map(|&(pixel, radius)| {
-            footprint(
+            footprint_with(
+                water_model,
                 scene,
                 model,
                 plane,
@@ -123,10 +126,37 @@ pub fn footprints(
 }
 
 /// The footprint of one pixel box (`probe` = centre pixel, radius; the box must lie inside the
-/// image). Mirrors the renderer's pixel sample: a jittered camera ray that misses the water,
-/// or a lobe sample below the surface, counts as a sample of weight 0.
+/// image) over the scene's water mesh ([`ExactSurface`]). Mirrors the renderer's pixel sample:
+/// a jittered camera ray that misses the water, or a lobe sample below the surface, counts as
+/// a sample of weight 0.
 #[allow(clippy::too_many_arguments)]
 pub fn footprint(
+    scene: &Scene,
+    model: &ReflectionModel,
+    plane: &LightPlane,
+    probe: (u32, u32),
+    width: u32,
+    height: u32,
+    samples: u32,
+    seed: u64,
+) -> Footprint {
+    footprint_with(
+        &ExactSurface,
+        scene,
+        model,
+        plane,
+        probe,
+        width,
+        height,
+        samples,
+        seed,
+    )
+}
+
+/// [`footprint`] with the water as `water_model` has it.
+#[allow(clippy::too_many_arguments)]
+pub fn footprint_with(
+    water_model: &dyn WaterModel,
     scene: &Scene,
     model: &ReflectionModel,
     plane: &LightPlane,
@@ -160,20 +190,16 @@ pub fn footprint(
                 (y + k / side).saturating_sub(radius),
             )
         };
-        let Some((start, sample)) = reflected_sample(scene, model, bx, by, width, height, &mut rng)
+        let Some((start, sample)) =
+            reflected_sample(water_model, scene, model, bx, by, width, height, &mut rng)
         else {
             continue;
         };
         // A ray that cannot reach the plane cannot land on it: no need to trace it, and one
         // that can need not look beyond it.
-        let towards = -sample.wi.dot(plane.normal);
-        if towards <= 0.0 {
+        let Some(t_plane) = plane.distance(start, sample.wi) else {
             continue;
-        }
-        let t_plane = (start - plane.point).dot(plane.normal) / towards;
-        if t_plane <= 0.0 {
-            continue;
-        }
+        };
         if let Some(hit) = first_surface(scene, start, sample.wi, t_plane * 1.001 + 1e-3) {
             if plane.contains_triangle(scene, hit.triangle) {
                 fp.points.push(plane.coords(start + sample.wi * hit.t));

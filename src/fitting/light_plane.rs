@@ -3,10 +3,12 @@
 
 use glam::{Vec2, Vec3};
 
+use super::plane::Plane;
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
-use crate::render::{camera_hit, trace, CameraHit, SceneHit};
+use crate::render::{trace, SceneHit};
 use crate::scene_in::Scene;
+use crate::water_model::WaterModel;
 
 /// The plane of one face of the scene (coplanar triangles of one glTF primitive), with the
 /// frame a light's rectangle is expressed in.
@@ -67,6 +69,32 @@ impl LightPlane {
     pub fn coords(&self, p: Vec3) -> Vec2 {
         let d = p - self.point;
         Vec2::new(d.dot(self.u), d.dot(self.v))
+    }
+
+    /// The plane as a [`Plane`]: its point and front normal.
+    pub fn plane(&self) -> Plane {
+        Plane {
+            point: self.point,
+            normal: self.normal,
+        }
+    }
+
+    /// How far along `dir` from `origin` the ray meets this plane's front side (the side the
+    /// reflected rays come from), in units of `dir`'s length, when it does ahead of `origin`.
+    #[inline]
+    pub fn distance(&self, origin: Vec3, dir: Vec3) -> Option<f32> {
+        self.plane()
+            .front_distance(origin, dir)
+            .filter(|&t| t > 0.0)
+    }
+
+    /// Where the ray from `origin` along `dir` meets this plane's front side, when it does
+    /// ahead of `origin`: the distance ([`distance`](Self::distance)) and the plane
+    /// coordinates (u, v) of the point.
+    #[inline]
+    pub fn hit(&self, origin: Vec3, dir: Vec3) -> Option<(f32, Vec2)> {
+        let t = self.distance(origin, dir)?;
+        Some((t, self.coords(origin + dir * t)))
     }
 
     /// The scene-frame point at plane coordinates (u, v).
@@ -141,9 +169,11 @@ pub enum PlaneSearch {
 }
 
 /// Casts `samples` lobe rays of pixel `pixel` (jittered over its footprint, exactly as the
-/// renderer samples it) and returns the face most of them hit first. Every triangle, the water
-/// included, takes part in the depth test.
+/// renderer samples it, the water as `water_model` has it) and returns the face most of them
+/// hit first. Every triangle, the water included, takes part in the depth test.
+#[allow(clippy::too_many_arguments)]
 pub fn find_plane(
+    water_model: &dyn WaterModel,
     scene: &Scene,
     model: &ReflectionModel,
     pixel: u32,
@@ -157,9 +187,12 @@ pub fn find_plane(
     let mut faces: Vec<FaceHits> = Vec::new();
     let (mut rays, mut water_hits) = (0u32, 0u32);
     for _ in 0..samples {
-        let Some((start, wi)) = reflected_ray(scene, model, x, y, width, height, &mut rng) else {
+        let Some((start, sample)) =
+            reflected_sample(water_model, scene, model, x, y, width, height, &mut rng)
+        else {
             continue;
         };
+        let wi = sample.wi;
         rays += 1;
         let SceneHit::Surface(hit) = trace(scene, &[], start, wi, 0.0) else {
             continue;
@@ -220,12 +253,15 @@ pub fn find_plane(
 }
 
 /// One camera sample of pixel (x, y) reflected off the water, with the renderer's model
-/// ([`crate::render`]: a jittered camera ray, the same shading and face normals, the same
-/// offset; the renderer additionally stratifies its camera rays and shares each among several
-/// lobe samples, which changes the noise but not the expectation): the reflected ray's origin
-/// together with the lobe sample, or `None` when the sample reflects nothing (the jittered ray misses the water, or
-/// the lobe sample is below the surface).
+/// ([`crate::render`] under [`crate::water_model::ExactSurface`]: a jittered camera ray, the
+/// same shading and face normals, the same offset; the renderer additionally stratifies its
+/// camera rays and shares each among several lobe samples, which changes the noise but not
+/// the expectation): the reflected ray's origin together with the lobe sample, or `None` when
+/// the sample reflects nothing (the jittered ray misses the water, or the lobe sample is below
+/// the surface). Draws four numbers from `rng` whatever happens: the jitter, then the lobe's.
+#[allow(clippy::too_many_arguments)]
 pub fn reflected_sample(
+    water_model: &dyn WaterModel,
     scene: &Scene,
     model: &ReflectionModel,
     x: u32,
@@ -237,20 +273,6 @@ pub fn reflected_sample(
     let jx = x as f32 + rng.next_f32();
     let jy = y as f32 + rng.next_f32();
     let u = Vec2::new(rng.next_f32(), rng.next_f32());
-    let CameraHit::Water(water) = camera_hit(scene, &[], jx, jy, width, height) else {
-        return None;
-    };
-    Some((water.start, water.reflect(model, u)?))
-}
-
-fn reflected_ray(
-    scene: &Scene,
-    model: &ReflectionModel,
-    x: u32,
-    y: u32,
-    width: u32,
-    height: u32,
-    rng: &mut Rng,
-) -> Option<(Vec3, Vec3)> {
-    reflected_sample(scene, model, x, y, width, height, rng).map(|(start, s)| (start, s.wi))
+    let water = water_model.water_point(scene, jx, jy, width, height)?;
+    Some((water.start, water_model.reflect(&water, model, u)?))
 }

@@ -16,14 +16,15 @@
 //!
 //! Fragments of one light are merged and refitted ([`fragments`]).
 
-mod control_variate;
 pub mod edges;
 pub mod footprint;
 pub mod fragments;
 pub mod gloss;
 pub mod joint;
 pub mod light_plane;
+mod linalg;
 pub mod observation;
+pub mod plane;
 pub mod radiance;
 pub mod rect;
 mod single;
@@ -41,6 +42,7 @@ pub use threshold::threshold_streaks;
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
+use crate::water_model::{ExactSurface, WaterModel};
 use crate::{Error, Result};
 
 /// How to fit.
@@ -284,8 +286,22 @@ pub(crate) fn check_sizes(photo: &Photo, water: &[bool]) -> Result<()> {
 ///
 /// `water` is the water mask of the photo ([`crate::water_mask::water_mask`]); `streaks` come
 /// from the streak extraction. Fails only on inconsistent inputs (sizes that do not match);
-/// a streak that cannot be fitted is reported in [`FitOutcome::skipped`].
+/// a streak that cannot be fitted is reported in [`FitOutcome::skipped`]. The water is the
+/// scene's water mesh ([`ExactSurface`]; [`fit_paper_with`] takes another model).
 pub fn fit_paper(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    options: &FitOptions,
+) -> Result<FitOutcome> {
+    fit_paper_with(&ExactSurface, scene, photo, water, streaks, options)
+}
+
+/// [`fit_paper`] with the water as `water_model` has it: the plane search and the footprints
+/// ask it where each camera ray meets the water and how its lobe leaves.
+pub fn fit_paper_with(
+    water_model: &dyn WaterModel,
     scene: &Scene,
     photo: &Photo,
     water: &[bool],
@@ -328,19 +344,27 @@ pub fn fit_paper(
         let mut scratch = single::StageTimes::default();
         let mut fitted: Vec<(StreakObservation, FittedLight)> = Vec::new();
         for obs in streaks {
-            match single::fit_streak(scene, photo, water, obs, &coarse, &mut scratch) {
+            match single::fit_streak(water_model, scene, photo, water, obs, &coarse, &mut scratch) {
                 Ok(light) => fitted.push((obs.clone(), light)),
                 Err(s) => skipped.push(s),
             }
         }
-        merge_fragments(scene, photo, water, &coarse, fitted, &mut warnings)
+        merge_fragments(
+            water_model,
+            scene,
+            photo,
+            water,
+            &coarse,
+            fitted,
+            &mut warnings,
+        )
     } else {
         streaks.iter().map(|s| (s.clone(), vec![s.id])).collect()
     };
     let fragments_seconds = t.elapsed().as_secs_f64();
     let mut lights = Vec::new();
     for (obs, ids) in &groups {
-        match single::fit_streak(scene, photo, water, obs, options, &mut times) {
+        match single::fit_streak(water_model, scene, photo, water, obs, options, &mut times) {
             Ok(mut light) => {
                 light.streak_ids = ids.clone();
                 lights.push(light);
@@ -375,6 +399,7 @@ pub fn fit_paper(
 /// overlap, refitting each union; returns the final groups' observations with the ids of the
 /// streaks in each.
 fn merge_fragments(
+    water_model: &dyn WaterModel,
     scene: &Scene,
     photo: &Photo,
     water: &[bool],
@@ -398,7 +423,8 @@ fn merge_fragments(
             .collect();
         ids.sort_unstable();
         let refit = fragments::merge(&obs_i, &obs_j, photo).map(|m| {
-            let fit = single::fit_streak(scene, photo, water, &m, options, &mut scratch);
+            let fit =
+                single::fit_streak(water_model, scene, photo, water, &m, options, &mut scratch);
             (m, fit)
         });
         match refit {

@@ -11,6 +11,7 @@ use super::rect::Rect;
 use super::{EdgeSide, EdgeStatus, FitOptions, FittedLight, Skipped};
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
+use crate::water_model::WaterModel;
 
 /// Seconds spent per stage, summed over streaks.
 #[derive(Clone, Copy, Debug, Default)]
@@ -45,8 +46,9 @@ struct EdgePixel {
     sides: [bool; 4],
 }
 
-/// Fits the light of one streak.
+/// Fits the light of one streak, the water as `water_model` has it.
 pub fn fit_streak(
+    water_model: &dyn WaterModel,
     scene: &Scene,
     photo: &Photo,
     water: &[bool],
@@ -57,6 +59,7 @@ pub fn fit_streak(
     let (w, h) = (photo.width, photo.height);
     let t = Instant::now();
     let search = find_plane(
+        water_model,
         scene,
         &options.model,
         obs.brightest,
@@ -143,6 +146,7 @@ pub fn fit_streak(
     traced.dedup();
     let t = Instant::now();
     let fps = footprints(
+        water_model,
         scene,
         &options.model,
         &plane,

@@ -8,6 +8,7 @@ use glam::{DVec3, Vec3};
 use serde_json::Value;
 
 use super::nodes::NodeInstance;
+use crate::fitting::plane::Plane;
 
 /// The draft's default intensity, used when a light omits it.
 const DEFAULT_INTENSITY: f64 = 1000.0;
@@ -36,11 +37,7 @@ impl AreaLight {
     /// front within `(tmin, tmax)`.
     #[inline]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<f32> {
-        let denom = dir.dot(self.normal);
-        if denom >= 0.0 {
-            return None;
-        }
-        let t = (self.center - origin).dot(self.normal) / denom;
+        let t = self.plane().front_distance(origin, dir)?;
         if !(t > tmin && t < tmax) {
             return None;
         }
@@ -48,6 +45,14 @@ impl AreaLight {
         let u = d.dot(self.half_width) / self.half_width.length_squared();
         let v = d.dot(self.half_height) / self.half_height.length_squared();
         (u.abs() <= 1.0 && v.abs() <= 1.0).then_some(t)
+    }
+
+    /// The plane of the emitting face, its front the emitting side.
+    pub fn plane(&self) -> Plane {
+        Plane {
+            point: self.center,
+            normal: self.normal,
+        }
     }
 
     /// Width (full).

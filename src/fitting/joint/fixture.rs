@@ -1,0 +1,108 @@
+//! Test fixture of the joint fit's unit tests: Table 3's photo and scene, light0 as the paper
+//! fits it, and every 8th pixel of its fitted region, for the tests that trace samples
+//! (in `samples`, `ramps` and `control_variate`).
+
+use super::region::{region, region_of_interest};
+use super::samples::{trace_samples, PlaneSamples};
+use crate::fitting::rect::Rect;
+use crate::fitting::{FittedLight, StreakObservation};
+use crate::optics::ReflectionModel;
+use crate::water_model::ExactSurface;
+
+/// Table 3's photo and scene, light0 as the paper fits it, and every 8th pixel of its
+/// fitted region: what the tests that trace samples read.
+pub(super) struct Table3Light0 {
+    pub(super) scene: crate::scene_in::Scene,
+    pub(super) model: ReflectionModel,
+    pub(super) light: FittedLight,
+    pub(super) roi: Rect,
+    pub(super) pixels: Vec<u32>,
+    pub(super) width: u32,
+    pub(super) height: u32,
+}
+
+pub(super) fn table3_light0() -> Table3Light0 {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!(
+        "streaklight-joint-{}-{:?}",
+        std::process::id(),
+        std::thread::current().id()
+    ));
+    crate::samples::write_scenes(&dir).expect("sample scenes");
+    let scene = crate::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
+    let _ = std::fs::remove_dir_all(&dir);
+    let photo = crate::photo_in::load(
+        &root.join("samples/table3.png"),
+        crate::samples::PHOTO_EXPOSURE,
+    )
+    .expect("photo");
+    let water = crate::water_mask::water_mask(&scene, photo.width, photo.height);
+    let segmented =
+        crate::streaks::extract_streaks(&photo, &water, &Default::default()).expect("streaks");
+    let observations: Vec<StreakObservation> = segmented
+        .streaks
+        .iter()
+        .map(|s| crate::convert::observation(s, photo.width))
+        .collect();
+    let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
+    let options = crate::fitting::FitOptions {
+        samples: 256,
+        seed: 1,
+        model,
+    };
+    let paper = crate::fitting::fit_paper(&scene, &photo, &water, &observations, &options)
+        .expect("paper fit");
+    let light = paper.lights[0].clone();
+    let roi = region_of_interest(&light.rect());
+    let used: Vec<&StreakObservation> = observations.iter().collect();
+    let pixels: Vec<u32> = region(
+        &ExactSurface,
+        &scene,
+        &model,
+        &[&light.plane],
+        &[roi],
+        &photo,
+        &water,
+        &used,
+        6,
+        true,
+    )
+    .into_iter()
+    .step_by(8)
+    .collect();
+    Table3Light0 {
+        scene,
+        model,
+        light,
+        roi,
+        pixels,
+        width: photo.width,
+        height: photo.height,
+    }
+}
+
+impl Table3Light0 {
+    pub(super) fn trace(
+        &self,
+        samples: u32,
+        seed: u64,
+        draw: u32,
+        cv: bool,
+    ) -> (Vec<PlaneSamples>, u32) {
+        trace_samples(
+            &ExactSurface,
+            &self.scene,
+            &self.model,
+            &[&self.light.plane],
+            &[self.roi],
+            &self.pixels,
+            self.width,
+            self.height,
+            samples,
+            seed,
+            0,
+            draw,
+            cv,
+        )
+    }
+}

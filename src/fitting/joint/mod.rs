@@ -1,0 +1,424 @@
+//! Joint refinement of all lights by render and compare (METHOD §5, last paragraph).
+//!
+//! The paper fits each streak alone from its edge pixels. Here every water pixel from which
+//! a light can be seen counts, and all lights are fitted together: minimise
+//!
+//! ```text
+//! S = sum_p sum_c (I_c(p) - sum_k L_k,c c_k(p; rect_k))^2
+//! ```
+//!
+//! where a clipped pixel only counts when the model is below it (it is a lower bound,
+//! METHOD §2). The fitted region is the streaks, dilated, plus every pixel near them whose
+//! reflected rays can reach a light's region of interest: a streak's faint ends fall below
+//! any segmentation's threshold, and an edge seen only through them would otherwise drift
+//! (`region`).
+//!
+//! Each pixel's coefficient is integrated over its footprint as the renderer does it (the
+//! forward model is a [`WaterModel`], by default the exact surface the renderer uses):
+//! stratified jittered camera rays, each with a stratified set of lobe samples, in two
+//! independent halves whose difference measures the estimate's noise. The samples that land
+//! on each light's plane inside its region of interest are traced ONCE (`samples`);
+//! afterwards `c_k(p; rect)` for any rectangle is a sum over stored samples, so the
+//! optimisation traces no ray. Each sample spreads its weight over a small kernel sized by its
+//! lobe cell, so that a coefficient changes smoothly with the rectangle's edges (`kernel`).
+//! The stored samples are common random numbers across all parameter values, so the cost is
+//! a deterministic function of the rectangles, and the coefficients' own noise is removed
+//! from it (`cost`).
+//!
+//! What noise is left is cut by a control variate (`control_variate`): per pixel a
+//! Gaussian on the light's plane, matched to the pixel's lobe, whose mass inside a rectangle
+//! is known in closed form. Each stored sample carries only its weight less the Gaussian's
+//! (so an edge cutting through the samples moves the estimate by far less noise), and the
+//! coefficient adds the Gaussian's exact mass back. The expectation is unchanged; on Table 3
+//! the noise of a coefficient's derivative by an edge is about a fifth in variance of the
+//! plain estimate's, and the fit's errors what 16 times the samples give without it
+//! (BENCHMARKS.md).
+//!
+//! The model is linear in the radiances: given the rectangles they are a nonnegative least
+//! squares solve per channel (`cost`). The edges are found by coordinate descent
+//! (`descent`) where each 1D step evaluates the cost on a whole grid of edge positions in
+//! one pass over the samples (prefix sums over binned samples: `ramps`, `profile`), with
+//! that light's radiance re-optimised in closed form at every grid point, so a far-off start
+//! (the paper's estimate can be metres off) is pulled in by a global 1D search rather than a
+//! local step. The grid then shrinks around the best position until it is finer than a
+//! millimetre. An edge that no pixel of the streak's edge looks at (outside the photo) is
+//! held where the paper method put it.
+//!
+//! Overlapping streaks (two lights whose reflections merge into one region, the paper's
+//! §5.3): when the residual of a fit is structured along the image rows, each light is tried
+//! as two (one above the other, or side by side: `split`), and the split is kept when it
+//! removes most of that structure. The second light of a split then reads a sample set of
+//! its own, drawn independently on the same plane, and the boundary between the two is
+//! searched globally before the final descent (`boundary`; the sequence: `optimise`).
+//!
+//! Independent repeats are averaged (`repeats`); the uncertainties come from the curvature
+//! of the cost the fit minimises (`uncertainty`).
+//!
+//! | file | what |
+//! |---|---|
+//! | `mod.rs` | options, outcome, [`fit_joint`] |
+//! | `region` | the fitted pixels, each light's region of interest |
+//! | `samples` | tracing and storing the plane samples, a coefficient from them |
+//! | `kernel` | each sample's cell and kernel |
+//! | `control_variate` | the lobe Gaussian |
+//! | `problem` | the fitted pixels with their samples, a fit's state |
+//! | `cost` | the cost, the coefficients' noise, the radiances' solve |
+//! | `ramps` | a coefficient at every grid position of one edge |
+//! | `profile` | the cost at every grid position of one edge |
+//! | `descent` | coordinate descent and its windows |
+//! | `optimise` | descent, split, boundary search, descent; repeats' replay |
+//! | `split`, `boundary` | overlapping streaks: the cut, the boundary search |
+//! | `repeats` | the mean of repeated fits and its standard error |
+//! | `uncertainty` | uncertainties, facing edges, edge statuses |
+
+use std::time::Instant;
+
+use crate::fitting::light_plane::LightPlane;
+use crate::fitting::rect::Rect;
+use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, StreakObservation};
+use crate::optics::ReflectionModel;
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+use crate::water_model::{ExactSurface, WaterModel};
+use crate::{Error, Result};
+
+mod boundary;
+mod control_variate;
+mod cost;
+mod descent;
+#[cfg(test)]
+mod fixture;
+mod kernel;
+mod optimise;
+mod problem;
+mod profile;
+mod ramps;
+mod region;
+mod repeats;
+mod samples;
+mod split;
+mod uncertainty;
+
+pub use samples::effective_samples;
+pub use uncertainty::{edge_statuses, Uncertainty};
+
+use optimise::optimise;
+use problem::{Problem, State};
+use region::{region, region_of_interest};
+use repeats::mean_and_spread;
+use samples::{sample_extent, trace_samples};
+use uncertainty::{facing_edges, uncertainties, FACING_REASON};
+
+/// How to refine.
+#[derive(Clone, Copy, Debug)]
+pub struct JointOptions {
+    /// Lobe samples per pixel of the fitted region. The cost sums over thousands of pixels, so
+    /// far fewer than the photo's own samples suffice.
+    pub samples: u32,
+    /// Seed of the footprints' random numbers.
+    pub seed: u64,
+    /// The water's reflection model.
+    pub model: ReflectionModel,
+    /// Pixels by which each streak is dilated to give the fitted region: the dark water around
+    /// a streak is what pins its edges down.
+    pub margin: u32,
+    /// Coordinate-descent sweeps, at most (each shrinks the search windows; the descent
+    /// stops once they are all at their smallest).
+    pub sweeps: u32,
+    /// Fit every pixel (false) or a checkerboard half of them (true): neighbouring pixels
+    /// carry nearly the same information, and the footprints are most of the cost.
+    pub checkerboard: bool,
+    /// Try explaining each light as two (overlapping streaks), keeping the split when it
+    /// fits the photo far better.
+    pub split: bool,
+    /// The gloss whose lobe decides which pixels around the streaks are fitted (`None`: the
+    /// model's). Fits under different glosses are comparable only over the same pixels, so a
+    /// gloss search fixes it to the broadest lobe it will try.
+    pub region_gloss: Option<f32>,
+    /// Independent fits, each from its own samples, whose mean is the result (at least 1).
+    /// From 2 on, their spread is added to the uncertainties (how far the samples move the
+    /// fit); the mean's own error falls as one over the square root of
+    /// the count.
+    pub repeats: u32,
+    /// Told a line as each repeat starts, when there are several (None: silent).
+    pub progress: Option<fn(&str)>,
+    /// Estimate the coefficients with the lobe Gaussian as a control variate (see the module
+    /// doc): the same expectation, far less noise. Off only to measure what it brings.
+    pub control_variate: bool,
+}
+
+impl JointOptions {
+    /// Defaults for a model and seed.
+    pub fn new(model: ReflectionModel, seed: u64) -> Self {
+        JointOptions {
+            samples: DEFAULT_JOINT_SAMPLES,
+            seed,
+            model,
+            margin: 6,
+            sweeps: 14,
+            checkerboard: true,
+            split: true,
+            region_gloss: None,
+            repeats: 1,
+            progress: None,
+            control_variate: true,
+        }
+    }
+}
+
+/// Default lobe samples per pixel of the joint fit.
+pub const DEFAULT_JOINT_SAMPLES: u32 = 72;
+
+/// The result of a joint fit.
+#[derive(Clone, Debug)]
+pub struct JointOutcome {
+    /// The refined lights, in the order given.
+    pub lights: Vec<FittedLight>,
+    /// Their uncertainties, in the same order.
+    pub uncertainty: Vec<Uncertainty>,
+    /// Pixels in the fitted region.
+    pub pixels: usize,
+    /// Residual sum of squares per pixel and channel at the optimum (radiance units squared).
+    pub residual_variance: f64,
+    /// The fit's cost at the optimum: the residual sum of squares less the samples' own noise
+    /// (module doc); comparable between fits of the same pixels. Not positive when the fit
+    /// has broken down (the photo's own noise keeps a sound fit's cost positive).
+    pub cost: f64,
+    /// Wall-clock seconds: "footprints" and "optimise".
+    pub timings: Vec<(String, f64)>,
+}
+
+/// Refines `start` (typically the paper's per-streak estimate) by fitting all lights together
+/// to every water pixel of their streaks and surroundings (see the module doc).
+///
+/// `streaks` must hold the streaks named by the lights' `streak_ids` (their pixels, dilated,
+/// are the fitted region). The lights' planes are kept; edges and radiances are refitted.
+/// The water is the scene's water mesh ([`ExactSurface`]; [`fit_joint_with`] takes another
+/// model).
+pub fn fit_joint(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    start: &[FittedLight],
+    options: &JointOptions,
+) -> Result<JointOutcome> {
+    fit_joint_with(&ExactSurface, scene, photo, water, streaks, start, options)
+}
+
+/// [`fit_joint`] with the water as `water_model` has it: the fitted region's probe rays, the
+/// stored samples and the control variates ask it where each camera ray meets the water and
+/// how its lobe leaves.
+pub fn fit_joint_with(
+    water_model: &dyn WaterModel,
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    start: &[FittedLight],
+    options: &JointOptions,
+) -> Result<JointOutcome> {
+    super::check_sizes(photo, water)?;
+    let n_all = photo.width as usize * photo.height as usize;
+    if options.samples == 0 {
+        return Err(Error::Usage(
+            "the joint fit needs at least one sample per pixel".into(),
+        ));
+    }
+    if options.repeats == 0 {
+        return Err(Error::Usage(
+            "the joint fit needs at least one repeat".into(),
+        ));
+    }
+    if start.is_empty() {
+        return Ok(JointOutcome {
+            lights: Vec::new(),
+            uncertainty: Vec::new(),
+            pixels: 0,
+            residual_variance: 0.0,
+            cost: 0.0,
+            timings: Vec::new(),
+        });
+    }
+    let used: Vec<&StreakObservation> = streaks
+        .iter()
+        .filter(|s| start.iter().any(|l| l.streak_ids.contains(&s.id)))
+        .collect();
+    if let Some(s) = used
+        .iter()
+        .find(|s| s.pixels.iter().any(|&p| p as usize >= n_all))
+    {
+        return Err(Error::Usage(format!(
+            "streak {} holds a pixel outside the {} x {} photo",
+            s.id, photo.width, photo.height
+        )));
+    }
+    let t0 = Instant::now();
+    let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
+    let roi: Vec<Rect> = start
+        .iter()
+        .map(|l| region_of_interest(&l.rect()))
+        .collect();
+    let probe_model = ReflectionModel {
+        gloss: options.region_gloss.unwrap_or(options.model.gloss),
+        ..options.model
+    };
+    let pixels = region(
+        water_model,
+        scene,
+        &probe_model,
+        &planes,
+        &roi,
+        photo,
+        water,
+        &used,
+        options.margin,
+        options.checkerboard,
+    );
+    let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
+        trace_samples(
+            water_model,
+            scene,
+            &options.model,
+            planes,
+            roi,
+            &pixels,
+            photo.width,
+            photo.height,
+            options.samples,
+            options.seed,
+            repeat,
+            draw,
+            options.control_variate,
+        )
+    };
+    let problem_for = |repeat: u32| {
+        let (stored, per_pixel_samples) = trace(&planes, &roi, repeat, 0);
+        Problem {
+            width: photo.width,
+            pixel_ids: pixels.clone(),
+            obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
+            clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
+            planes: stored,
+            set_origin: (0..planes.len()).collect(),
+            inv_samples: 1.0 / per_pixel_samples as f32,
+        }
+    };
+    // Seconds spent tracing the split lights' own sample sets (footprints, not optimisation).
+    let fresh_seconds = std::cell::Cell::new(0.0);
+    // The `draw`-th extra sample set of repeat `repeat`, on start light `origin`'s plane,
+    // independent of every other set.
+    let fresh_set = |repeat: u32, origin: usize, draw: u32| {
+        let t = Instant::now();
+        let (mut stored, _) = trace(&[planes[origin]], &[roi[origin]], repeat, draw);
+        fresh_seconds.set(fresh_seconds.get() + t.elapsed().as_secs_f64());
+        // One plane in, one set out.
+        stored.swap_remove(0)
+    };
+    let mut problem = problem_for(0);
+    let mut footprint_seconds = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
+    let (first, replay) = optimise(
+        &mut problem,
+        start,
+        &mut extents,
+        options.sweeps,
+        options.split,
+        &|origin, draw| fresh_set(0, origin, draw),
+    );
+    let mut optimise_seconds = t1.elapsed().as_secs_f64();
+    let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
+    for repeat in 1..options.repeats {
+        if let Some(say) = options.progress {
+            say(&format!(
+                "joint fit: repeat {} of {} (independent samples)",
+                repeat + 1,
+                options.repeats
+            ));
+        }
+        let t = Instant::now();
+        let mut again = problem_for(repeat);
+        footprint_seconds += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let mut extents: Vec<Option<Rect>> = again.planes.iter().map(sample_extent).collect();
+        let extra_origins = &problem.set_origin[start.len()..];
+        let st = again.replay(
+            &replay,
+            extra_origins,
+            &mut extents,
+            options.sweeps,
+            &|origin, draw| fresh_set(repeat, origin, draw),
+        );
+        repeats.push((st.rects, st.radiance));
+        optimise_seconds += t.elapsed().as_secs_f64();
+    }
+    footprint_seconds += fresh_seconds.get();
+    optimise_seconds -= fresh_seconds.get();
+    let t2 = Instant::now();
+    let (st, spread) = if repeats.len() == 1 {
+        // One fit: the curvature alone (see `uncertainties`). With the control variate it
+        // covers the errors (8 seeds through the pipeline: Table 3 0.5-1.3 sigma rms, largest
+        // 2.1; the stacked sample 0.3-1.2, largest 1.8); adding the spread of two refits, one
+        // from each half of the samples, would cost 0.7 s of Table 3's fit and only widen the
+        // sigmas further (BENCHMARKS.md, "A control variate for the coefficients").
+        (first, None)
+    } else {
+        let (rects, radiance, spread) = mean_and_spread(&repeats);
+        let st = problem.state(
+            first.set_of.clone(),
+            first.pinned.clone(),
+            rects,
+            radiance.clone(),
+        );
+        // The mean's radiances, not the ones the first fit's samples would give its edges.
+        (State { radiance, ..st }, Some(spread))
+    };
+    let cost = problem.cost(&st);
+    let dof = (problem.n() * 3).saturating_sub(7 * st.rects.len()).max(1) as f64;
+    let variance = (cost / dof).max(f64::MIN_POSITIVE);
+    let mut uncertainty = uncertainties(&problem, &st, &extents);
+    // The repeats' spread, where there are several, adds to the curvature's.
+    for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
+        u.edges = [0, 1, 2, 3].map(|e| u.edges[e].map(|sd| sd.hypot(edges[e])));
+        u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
+    }
+    optimise_seconds += t2.elapsed().as_secs_f64();
+    let facing = facing_edges(&problem, &st);
+    let lights = (0..st.rects.len())
+        .map(|k| {
+            let origin = &start[problem.set_origin[st.set_of[k]]];
+            let (r, rad) = (st.rects[k], st.radiance[k]);
+            let mut edges = origin.edges.clone();
+            for side in EdgeSide::ALL {
+                if facing[k][side as usize] {
+                    edges[side as usize] = EdgeStatus::Unconstrained {
+                        reason: FACING_REASON.into(),
+                        unseen: false,
+                    };
+                }
+            }
+            FittedLight {
+                streak_ids: origin.streak_ids.clone(),
+                plane: origin.plane.clone(),
+                u_min: r.u_min,
+                u_max: r.u_max,
+                v_min: r.v_min,
+                v_max: r.v_max,
+                radiance: rad.map(|c| c as f32),
+                edges,
+            }
+        })
+        .collect();
+    Ok(JointOutcome {
+        lights,
+        uncertainty,
+        pixels: pixels.len(),
+        residual_variance: variance,
+        cost,
+        timings: vec![
+            ("footprints".into(), footprint_seconds),
+            ("optimise".into(), optimise_seconds),
+        ],
+    })
+}

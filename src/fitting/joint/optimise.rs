@@ -1,0 +1,118 @@
+//! The joint fit's optimisation (METHOD §5, last paragraph): a descent from the start lights,
+//! then, for overlapping streaks, a split, a boundary search and another descent.
+//!
+//! Overlapping streaks (two lights whose reflections merge into one region, the paper's
+//! §5.3): when the residual of a fit is structured along the image rows
+//! ([`Problem::structured`]), each light is tried as two, one above the other or side by side
+//! ([`try_split`]), and the split is kept when it removes most of that structure. The second
+//! light of a split then reads a sample set of its own, drawn independently on the same
+//! plane, and the boundary between the two is searched globally ([`search_boundary`]) before
+//! the final descent. A repeat on other samples ([`Problem::replay`]) starts from where the
+//! last descent started.
+
+use super::boundary::{search_boundary, CANDIDATE_SWEEPS};
+use super::problem::{Problem, State};
+use super::samples::{sample_extent, PlaneSamples};
+use super::split::try_split;
+use crate::fitting::rect::Rect;
+use crate::fitting::{EdgeStatus, FittedLight};
+
+/// Fits the lights from `start`: a descent, then a split of any light whose residual is
+/// structured (see [`try_split`]), the second light of each split given a sample set of its
+/// own (`fresh(origin, draw)`: the `draw`-th extra set on start light `origin`'s plane) and
+/// the boundary between the two placed by [`search_boundary`], and another descent. Returns
+/// the optimum and the state its last descent started from (the start, or the split lights
+/// after their boundary search): a repeat on other samples starts there (see
+/// [`Problem::replay`]).
+pub(super) fn optimise(
+    problem: &mut Problem,
+    start: &[FittedLight],
+    extents: &mut Vec<Option<Rect>>,
+    sweeps: u32,
+    split: bool,
+    fresh: &dyn Fn(usize, u32) -> PlaneSamples,
+) -> (State, State) {
+    let mut st = problem.state(
+        (0..start.len()).collect(),
+        start
+            .iter()
+            .map(|l| {
+                l.edges
+                    .clone()
+                    .map(|e| matches!(e, EdgeStatus::Unconstrained { unseen: true, .. }))
+            })
+            .collect(),
+        start
+            .iter()
+            .zip(extents.iter())
+            .map(|(l, e)| e.map_or(l.rect(), |e| l.rect().clamp_to(&e)))
+            .collect(),
+        start.iter().map(|l| l.radiance.map(f64::from)).collect(),
+    );
+    let mut replay = st.clone();
+    problem.descend(&mut st, extents, sweeps);
+    if split && problem.structured(&st) {
+        for k in 0..start.len() {
+            let Some((trial, inner)) = try_split(problem, &st, k, extents) else {
+                continue;
+            };
+            st = trial;
+            let b = st.rects.len() - 1;
+            // The two lights of a split read independent samples: with one set shared, the
+            // cost's noise along their common boundary has minima far from the truth
+            // (BENCHMARKS.md, the stacked sample).
+            let origin = problem.set_origin[st.set_of[k]];
+            let draw = (problem.planes.len() - start.len()) as u32 + 1;
+            let samples = fresh(origin, draw);
+            extents.push(sample_extent(&samples));
+            let set = problem.add_set(samples, origin);
+            problem.move_to_set(&mut st, b, set);
+            let starts = search_boundary(problem, &st, k, b, inner);
+            let mut best: Option<(State, f64)> = None;
+            for mut cand in starts {
+                problem.descend(&mut cand, extents, CANDIDATE_SWEEPS);
+                let c = problem.cost(&cand);
+                if best.as_ref().is_none_or(|(_, b)| c < *b) {
+                    best = Some((cand, c));
+                }
+            }
+            if let Some((cand, _)) = best {
+                st = cand;
+            }
+        }
+        if problem.planes.len() > start.len() {
+            replay = st.clone();
+            problem.descend(&mut st, extents, sweeps);
+        }
+    }
+    (st, replay)
+}
+
+impl Problem {
+    /// The fit that `optimise` made, repeated on this problem's samples: from `from`, the
+    /// state its last descent started from, whose extra sample sets (one per light a split
+    /// added, on start light `extra_origins[j]`'s plane) `fresh` draws anew, as in
+    /// [`optimise`].
+    pub(super) fn replay(
+        &mut self,
+        from: &State,
+        extra_origins: &[usize],
+        extents: &mut Vec<Option<Rect>>,
+        sweeps: u32,
+        fresh: &dyn Fn(usize, u32) -> PlaneSamples,
+    ) -> State {
+        for (draw, &origin) in extra_origins.iter().enumerate() {
+            let samples = fresh(origin, draw as u32 + 1);
+            extents.push(sample_extent(&samples));
+            self.add_set(samples, origin);
+        }
+        let mut st = self.state(
+            from.set_of.clone(),
+            from.pinned.clone(),
+            from.rects.clone(),
+            from.radiance.clone(),
+        );
+        self.descend(&mut st, extents, sweeps);
+        st
+    }
+}

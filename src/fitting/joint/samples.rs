@@ -1,0 +1,407 @@
+//! The joint fit's stored plane samples (METHOD §5, last paragraph): each fitted pixel's
+//! coefficient integrated over its footprint as the renderer does it, from samples traced
+//! once.
+//!
+//! Per pixel, stratified jittered camera rays, each with a stratified set of lobe samples, in
+//! two independent halves whose difference measures the estimate's noise (see the note on
+//! the coefficients' noise in [`super::cost`]). The samples that land on each light's plane
+//! inside its region of interest are stored ([`PlaneSamples`], traced by [`trace_samples`]);
+//! afterwards `c_k(p; rect)` for any rectangle is a sum over stored samples
+//! ([`PlaneSamples::coefficient`]), so the optimisation traces no ray. Each sample spreads its
+//! weight over a small kernel sized by its lobe cell ([`super::kernel`]) and carries its weight
+//! less the control variate's ([`super::control_variate`]). The stored samples are common
+//! random numbers across all parameter values, so the cost is a deterministic function of the
+//! rectangles.
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::control_variate::{self, LobeGaussian};
+use super::kernel::{cell_half_extents, kernel_coverage, LobeNeighbours};
+use crate::fitting::light_plane::LightPlane;
+use crate::fitting::rect::Rect;
+use crate::optics::{compact_strata, ReflectionModel};
+use crate::random::Rng;
+use crate::scene_in::Scene;
+use crate::water_model::WaterModel;
+
+/// Stream tag of the joint fit's random numbers: distinct from the renderer's (the bare pixel
+/// index), from the plane search's and from the paper fit's footprints, so the fit never
+/// reuses the photo's own noise.
+pub(super) const JOINT_STREAM: u64 = 3 << 48;
+
+/// Stored samples of one light's plane: per fitted pixel, a range of points and weights, and
+/// which of the pixel's two independent halves each belongs to (what the coefficients'
+/// variance is estimated from).
+pub(super) struct PlaneSamples {
+    /// Per pixel, where its samples start (and, at `i + 1`, end) in the per-sample vectors.
+    pub(super) offsets: Vec<u32>,
+    /// Per pixel, the bounding box of its samples' kernels ([`Rect::EMPTY`] for a pixel with
+    /// none).
+    pub(super) bbox: Vec<Rect>,
+    /// Per sample, where it lands (plane coordinates).
+    pub(super) points: Vec<Vec2>,
+    /// Per sample, the half-widths of its kernel along the plane's axes (see
+    /// [`cell_half_extents`] and [`super::kernel`]).
+    pub(super) cells: Vec<Vec2>,
+    /// Per sample, its weight less the control variate's (see [`super::control_variate`]):
+    /// negative where the Gaussian outweighs the lobe.
+    pub(super) weights: Vec<f32>,
+    /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1).
+    pub(super) halves: Vec<f32>,
+    /// Per pixel, the control variate ([`LobeGaussian::NONE`] without).
+    pub(super) gauss: Vec<LobeGaussian>,
+    /// The smallest width and height a light on this plane may take ([`smallest_light`]).
+    pub(super) min_size: Vec2,
+}
+
+impl PlaneSamples {
+    /// Pixel i's samples in the per-sample vectors.
+    pub(super) fn range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i] as usize..self.offsets[i + 1] as usize
+    }
+
+    /// Pixel i's `(c, d)` for `rect`: the coefficient and its half-difference (see the note
+    /// on the coefficients' noise in [`super::cost`]).
+    pub(super) fn coefficient(&self, i: usize, rect: &Rect, inv_samples: f32) -> (f32, f32) {
+        let r = self.range(i);
+        let (mut sum, mut signed) = (0f32, 0f32);
+        for (((p, h), &w), &half) in self.points[r.clone()]
+            .iter()
+            .zip(&self.cells[r.clone()])
+            .zip(&self.weights[r.clone()])
+            .zip(&self.halves[r])
+        {
+            let f = kernel_coverage(p.x, h.x, rect.u_min, rect.u_max)
+                * kernel_coverage(p.y, h.y, rect.v_min, rect.v_max);
+            if f != 0.0 {
+                sum += w * f;
+                signed += w * half * f;
+            }
+        }
+        (
+            sum * inv_samples + self.gauss[i].mass_inside(rect),
+            signed * inv_samples,
+        )
+    }
+}
+
+/// Camera rays per side of a pixel's stratification grid: 2 x 2 jittered camera rays cover
+/// the footprint evenly, and the lobe is sampled several times from each.
+pub(super) const CAMERA_STRATA: u32 = 2;
+
+/// The samples per pixel a joint fit asked for `samples` actually takes: the count is
+/// rounded to two halves of `CAMERA_STRATA^2` camera rays times a square number of lobe
+/// samples (8, 32, 72, 128, 200, 288, ...).
+pub fn effective_samples(samples: u32) -> u32 {
+    2 * CAMERA_STRATA * CAMERA_STRATA * lobe_strata(samples).pow(2)
+}
+
+/// Lobe strata per side for `samples` samples per pixel. A pixel's samples are two
+/// independent halves (for the variance estimate), each `CAMERA_STRATA^2` camera rays times
+/// `lobe_strata^2` lobe samples, so the count is rounded to `32 b^2`. Stratifying the lobe
+/// matters: a coefficient is the lobe's mass inside a rectangle, and stratified samples
+/// estimate that with far less noise than independent ones, which is what lets the edges
+/// settle at the photo's optimum rather than at the samples' noise; reusing each camera
+/// ray's water hit for several lobe samples makes them cheap.
+///
+/// Within a half, the camera rays' lobe strata interleave: the half's lobe numbers form one
+/// grid of `CAMERA_STRATA * lobe_strata` strata per side, and each camera ray takes every
+/// `CAMERA_STRATA`-th stratum from its own offset (the offsets shuffled per half), so the
+/// half is stratified four times finer than one camera ray's share (the water's normal
+/// changes little across a pixel, so the rays' lobes nearly coincide). The numbers then go
+/// through [`compact_strata`], which makes each stratum a compact cell around the lobe's axis
+/// instead of a thin ring sector. Measured on Table 3 over six seeds of the fit's own
+/// samples (BENCHMARKS.md): the edges' and radiance's spread fell by 10-50 %, for nothing.
+fn lobe_strata(samples: u32) -> u32 {
+    let per_ray = samples as f32 / (2 * CAMERA_STRATA * CAMERA_STRATA) as f32;
+    (per_ray.sqrt().round() as u32).max(1)
+}
+
+/// Traces every pixel's samples once and stores, per light, those whose first hit is that
+/// light's plane inside its region of interest `roi[k]` (a sample landing on a face shared by
+/// several lights is stored for each). A sample whose ray meets no plane inside a region of
+/// interest is never traced: it could not change any coefficient the fit will evaluate.
+/// With the control variate (`gaussians`), a sample whose ray would meet a light's plane
+/// inside its region of interest but hits something else first (or nothing: the wall ends)
+/// is stored too, with the lobe's weight 0: the Gaussian it subtracts must be subtracted
+/// wherever the Gaussian is, or the estimate would see light through the obstacle.
+/// `repeat` and `draw` select independent random streams: `draw` 0 is the set every start
+/// light reads, `draw` 1, 2, ... the sets of lights that splits added (one plane each).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn trace_samples(
+    water_model: &dyn WaterModel,
+    scene: &Scene,
+    model: &ReflectionModel,
+    planes: &[&LightPlane],
+    roi: &[Rect],
+    pixels: &[u32],
+    width: u32,
+    height: u32,
+    samples: u32,
+    seed: u64,
+    repeat: u32,
+    draw: u32,
+    gaussians: bool,
+) -> (Vec<PlaneSamples>, u32) {
+    type Hits = (Vec<(u16, Vec2, Vec2, f32, f32)>, Vec<LobeGaussian>);
+    let lobe = lobe_strata(samples);
+    let per_pixel_samples = effective_samples(samples);
+    let per_pixel: Vec<Hits> = pixels
+        .par_iter()
+        .map(|&pixel| {
+            let stream = JOINT_STREAM | (draw as u64) << 52 | (repeat as u64) << 32 | pixel as u64;
+            let mut rng = Rng::new(seed, stream);
+            let (x, y) = (pixel % width, pixel / width);
+            let mut hits = Vec::new();
+            let mut missed_water = 0u32;
+            // The control variates, matched to the pixel's first camera ray to meet the water
+            // before any of its lobe samples is drawn: they depend on no lobe sample, so the
+            // estimate keeps its expectation.
+            let mut gauss: Option<Vec<LobeGaussian>> = None;
+            let inv_c = 1.0 / CAMERA_STRATA as f32;
+            let inv_grid = 1.0 / (lobe * CAMERA_STRATA) as f32;
+            let mut offsets: Vec<u32> = (0..CAMERA_STRATA * CAMERA_STRATA).collect();
+            for (cs, half_sign) in (0..2 * CAMERA_STRATA * CAMERA_STRATA).map(|i| {
+                (
+                    i % (CAMERA_STRATA * CAMERA_STRATA),
+                    if i < CAMERA_STRATA * CAMERA_STRATA {
+                        1.0
+                    } else {
+                        -1.0
+                    },
+                )
+            }) {
+                if cs == 0 {
+                    shuffle(&mut offsets, &mut rng);
+                }
+                let (ox, oy) = (
+                    offsets[cs as usize] % CAMERA_STRATA,
+                    offsets[cs as usize] / CAMERA_STRATA,
+                );
+                let fx = ((cs % CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
+                let fy = ((cs / CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
+                let Some(water) =
+                    water_model.water_point(scene, x as f32 + fx, y as f32 + fy, width, height)
+                else {
+                    missed_water += 1;
+                    // Draw the lobe numbers anyway, so that every camera ray of a pixel uses
+                    // the same stream positions whatever the others hit.
+                    for _ in 0..lobe * lobe {
+                        rng.next_f32();
+                        rng.next_f32();
+                    }
+                    continue;
+                };
+                let gauss = gauss.get_or_insert_with(|| {
+                    if !gaussians {
+                        return vec![LobeGaussian::NONE; planes.len()];
+                    }
+                    let (dirs, count) =
+                        control_variate::lobe_directions(water_model, model, &water);
+                    planes
+                        .iter()
+                        .map(|plane| LobeGaussian::matched(plane, water.start, &dirs, count))
+                        .collect()
+                });
+                for ls in 0..lobe * lobe {
+                    let grid_u = Vec2::new(
+                        (((ls % lobe) * CAMERA_STRATA + ox) as f32 + rng.next_f32()) * inv_grid,
+                        (((ls / lobe) * CAMERA_STRATA + oy) as f32 + rng.next_f32()) * inv_grid,
+                    );
+                    let u = compact_strata(grid_u);
+                    let Some(s) = water_model.reflect(&water, model, u) else {
+                        continue;
+                    };
+                    // The farthest plane it lands on inside a region of interest: nothing
+                    // beyond it matters, so the trace stops there.
+                    let reach = planes
+                        .iter()
+                        .zip(roi)
+                        .filter_map(|(plane, r)| {
+                            let (t, q) = plane.hit(water.start, s.wi)?;
+                            r.contains(q).then_some(t)
+                        })
+                        .reduce(f32::max);
+                    let Some(reach) = reach else {
+                        continue;
+                    };
+                    let tmax = reach * 1.001 + 1e-3;
+                    let hit = scene.tracer.closest_hit(water.start, s.wi, 0.0, tmax);
+                    let mut lobe_cell = None;
+                    for (k, plane) in planes.iter().enumerate() {
+                        let g = &gauss[k];
+                        let on_plane = hit.filter(|h| plane.contains_triangle(scene, h.triangle));
+                        // Where the ray lands on the plane, how far, and the lobe's weight there.
+                        let (q, t, lobe_weight) = match on_plane {
+                            Some(h) => (plane.coords(water.start + s.wi * h.t), h.t, s.weight),
+                            None if !g.is_none() => {
+                                let Some((t, q)) = plane.hit(water.start, s.wi) else {
+                                    continue;
+                                };
+                                if !roi[k].contains(q) {
+                                    continue;
+                                }
+                                (q, t, 0.0)
+                            }
+                            None => continue,
+                        };
+                        let lobe_cell = lobe_cell.get_or_insert_with(|| {
+                            LobeNeighbours::new(water_model, model, &water, s.wi, grid_u, inv_grid)
+                        });
+                        let cell = cell_half_extents(lobe_cell, water.start, plane);
+                        // Another light's sample on a shared wall, out of this light's
+                        // reach: it could never fall in its rectangle.
+                        if !roi[k].overlaps(&Rect::around(q, cell)) {
+                            continue;
+                        }
+                        let weight = if g.is_none() {
+                            lobe_weight
+                        } else {
+                            // The Gaussian's density over the density the sample was drawn
+                            // with, both per unit area of the plane.
+                            let area_pdf = s.pdf * s.wi.dot(plane.normal).abs() / (t * t);
+                            if area_pdf > 0.0 {
+                                lobe_weight - g.density(q) / area_pdf
+                            } else {
+                                lobe_weight
+                            }
+                        };
+                        if weight != 0.0 {
+                            hits.push((k as u16, q, cell, weight, half_sign));
+                        }
+                    }
+                }
+            }
+            // A camera ray that misses the water draws nothing, so nothing of the Gaussian
+            // is subtracted for it: the closed-form part counts only the rays that drew.
+            let drew = 1.0 - missed_water as f32 / (2 * CAMERA_STRATA * CAMERA_STRATA) as f32;
+            let mut gauss = gauss.unwrap_or_else(|| vec![LobeGaussian::NONE; planes.len()]);
+            for g in gauss.iter_mut() {
+                g.mass *= drew;
+            }
+            (hits, gauss)
+        })
+        .collect();
+    let stored = (0..planes.len())
+        .map(|k| {
+            let mut out = PlaneSamples {
+                offsets: Vec::with_capacity(pixels.len() + 1),
+                bbox: Vec::with_capacity(pixels.len()),
+                points: Vec::new(),
+                cells: Vec::new(),
+                weights: Vec::new(),
+                halves: Vec::new(),
+                gauss: Vec::with_capacity(pixels.len()),
+                min_size: Vec2::ZERO,
+            };
+            out.offsets.push(0);
+            for (hits, gauss) in &per_pixel {
+                out.gauss.push(gauss[k]);
+                for &(kk, p, cell, w, half) in hits {
+                    if kk as usize == k {
+                        out.points.push(p);
+                        out.cells.push(cell);
+                        out.weights.push(w);
+                        out.halves.push(half);
+                    }
+                }
+                let first = *out.offsets.last().unwrap_or(&0) as usize;
+                let mut bb = Rect::EMPTY;
+                for (p, h) in out.points[first..].iter().zip(&out.cells[first..]) {
+                    bb = bb.union(&Rect::around(*p, *h));
+                }
+                out.bbox.push(bb);
+                out.offsets.push(out.points.len() as u32);
+            }
+            out.min_size = smallest_light(&out.cells);
+            out
+        })
+        .collect();
+    (stored, per_pixel_samples)
+}
+
+/// Fisher-Yates shuffle from the pixel's own stream.
+fn shuffle(items: &mut [u32], rng: &mut Rng) {
+    for i in (1..items.len()).rev() {
+        let j = ((rng.next_f32() * (i + 1) as f32) as usize).min(i);
+        items.swap(i, j);
+    }
+}
+
+/// The smallest width and height of a light whose samples' kernels have the half-widths
+/// `cells`: twice the median half-width along each axis, the kernels' typical full width (a
+/// few millimetres when the cells are points). A narrower rectangle is seen only through the
+/// kernels' shape (its coefficient is the kernels' density where it lies, negative lobes
+/// included, from the few samples near it), so its coefficients are noise out of all
+/// proportion to their size, and the fit, which subtracts the estimated noise from its cost,
+/// rewards exactly that: two stacked lights 1.8 m apart came out as the lower light and a
+/// 1 mm sliver at 1400 times the radiance, at a cost 90 below the truth's (BENCHMARKS.md,
+/// "A sliver of light"). A real light narrower than the bound (a strip light) comes out this
+/// wide, with the radiance that keeps its reflection; more samples per pixel make the kernels,
+/// and the bound, smaller.
+pub(super) fn smallest_light(cells: &[Vec2]) -> Vec2 {
+    // Every 8th sample: a median needs no more, and a plane holds millions.
+    let (mut xs, mut ys): (Vec<f32>, Vec<f32>) =
+        cells.iter().step_by(8).map(|c| (c.x, c.y)).unzip();
+    let median = |v: &mut Vec<f32>| {
+        if v.is_empty() {
+            return 0.0;
+        }
+        let mid = v.len() / 2;
+        *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
+    };
+    Vec2::new(2.0 * median(&mut xs), 2.0 * median(&mut ys)).max(Vec2::splat(2e-3))
+}
+
+/// How far the photo could possibly move an edge: the extent of light k's stored samples.
+pub(super) fn sample_extent(p: &PlaneSamples) -> Option<Rect> {
+    p.bbox
+        .iter()
+        .filter(|b| !b.is_empty())
+        .copied()
+        .reduce(|a, b| a.union(&b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixture::table3_light0;
+    use super::*;
+
+    #[test]
+    fn extra_sample_sets_are_independent_draws_of_the_same_coefficients() {
+        // A split light's own set (draw 1) against the set every light reads (draw 0): other
+        // samples, the same expectation.
+        let t = table3_light0();
+        let rect = t.light.rect();
+        let sums = |draw: u32| -> (Vec<Vec2>, Vec<f64>) {
+            let (planes, n) = t.trace(72, 1, draw, true);
+            let inv = 1.0 / n as f32;
+            let c = (0..t.pixels.len())
+                .map(|i| planes[0].coefficient(i, &rect, inv).0 as f64)
+                .collect();
+            (planes[0].points.clone(), c)
+        };
+        let (points0, c0) = sums(0);
+        let (points1, c1) = sums(1);
+        let shared = points0.iter().zip(&points1).filter(|(a, b)| a == b).count();
+        assert!(
+            shared * 100 < points0.len(),
+            "{shared} of {} points alike",
+            points0.len()
+        );
+        let total: f64 = c0.iter().sum();
+        let diff: f64 = c0.iter().zip(&c1).map(|(a, b)| a - b).sum();
+        // The two sums differ by their samples' noise alone: per pixel the half-differences
+        // measure it; summed over the pixels the relative difference is far under 1 %.
+        assert!(total > 0.0);
+        assert!(
+            (diff / total).abs() < 0.005,
+            "sums {total} and {}",
+            total - diff
+        );
+        // Not the same numbers: the pixels' values differ.
+        let differing = c0.iter().zip(&c1).filter(|(a, b)| a != b).count();
+        assert!(differing * 2 > c0.iter().filter(|c| **c != 0.0).count());
+    }
+}

@@ -1,0 +1,226 @@
+//! The joint fit's uncertainties and edge statuses (METHOD §5, last paragraph): one-sigma
+//! uncertainties of every light's edges and radiances from the curvature of the cost the fit
+//! minimises, and which edges the photo does not determine.
+
+use super::problem::{Problem, State};
+use crate::fitting::linalg::invert;
+use crate::fitting::rect::Rect;
+use crate::fitting::{EdgeSide, EdgeStatus, FittedLight};
+
+/// One-sigma uncertainties of a light's parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uncertainty {
+    /// Left, right, bottom and top edges, metres along the plane's axes (indexed by
+    /// [`EdgeSide`]). `None` when the photo does not constrain the edge (flat cost).
+    pub edges: [Option<f32>; 4],
+    /// Radiance per channel, in radiance units.
+    pub radiance: [f32; 3],
+}
+
+/// One-sigma uncertainties of every light's free edges and radiances, from their full
+/// covariance at once (Gauss-Newton, made robust to uneven noise: see below), J being the
+/// model's derivatives at every unclipped fitted pixel and channel. Holding the other
+/// parameters fixed, as a per-edge curvature would, understates errors that travel along
+/// correlated directions (a light's height against its radiance when only one end of its
+/// streak is seen); the full covariance carries them.
+///
+/// An edge's derivative is the change of the coefficients over a step of 2 % of the light's
+/// size (at least 5 mm) each way: below a few millimetres the stored samples make the
+/// coefficients a staircase. An edge that moves nothing gets no uncertainty (`None`: the photo
+/// does not constrain it), and so does a pinned one.
+pub(super) fn uncertainties(
+    problem: &Problem,
+    st: &State,
+    extents: &[Option<Rect>],
+) -> Vec<Uncertainty> {
+    let lights = st.rects.len();
+    // Parameters: per light its free edges (with the coefficients' derivative and the
+    // derivative of their half-difference), then its three radiances.
+    enum Param {
+        Edge(usize, EdgeSide, Vec<f32>, Vec<f32>),
+        Radiance(usize, usize),
+    }
+    let mut params: Vec<Param> = Vec::new();
+    for k in 0..lights {
+        let r = st.rects[k];
+        let h = (0.02 * r.width().max(r.height())).max(0.005);
+        for side in EdgeSide::ALL {
+            if st.pinned[k][side as usize] || extents[st.set_of[k]].is_none() {
+                continue;
+            }
+            let e = r.edge(side);
+            let set = st.set_of[k];
+            let (g, g_dev) =
+                problem.edge_slopes(set, &r.with_edge(side, e + h), &r.with_edge(side, e - h), h);
+            if g.iter().any(|&x| x != 0.0) {
+                params.push(Param::Edge(k, side, g, g_dev));
+            }
+        }
+        for ch in 0..3 {
+            params.push(Param::Radiance(k, ch));
+        }
+    }
+    let p = params.len();
+    // d model[i][ch] / d param and d (half-difference)[i][ch] / d param.
+    let derivative = |param: &Param, i: usize, ch: usize| -> (f64, f64) {
+        match param {
+            Param::Edge(k, _, g, gd) => (
+                st.radiance[*k][ch] * g[i] as f64,
+                st.radiance[*k][ch] * gd[i] as f64,
+            ),
+            Param::Radiance(k, c) if *c == ch => (st.coef[*k][i] as f64, st.dev[*k][i] as f64),
+            Param::Radiance(..) => (0.0, 0.0),
+        }
+    };
+    // Sandwich (cluster-robust) covariance: bread^-1 meat bread^-1, with the bread and the
+    // scores those of the cost the fit minimises, sum of r^2 - d^2 (see the note on the
+    // coefficients' noise in `cost`): bread = sum of (J J^T - Jd Jd^T), score per pixel = sum
+    // over channels of (r J + d Jd). The plain J^T J counts the samples' noise in the
+    // derivatives as curvature (E[J_est J_est^T] = J J^T + their variance), so along a
+    // direction the photo barely constrains (Table 3's light1: its height against its
+    // radiance) it claims several times the real curvature and the sigmas come out small
+    // (BENCHMARKS.md, "Uncertainties: the curvature of the cost the fit minimises"). The noise is far from uniform (a streak's bright pixels carry most
+    // of it, the dark surroundings none), the three channels of a pixel share it (a white
+    // light), and the stored samples add their own: a single variance sigma^2 for all would
+    // understate the errors tenfold (measured on Table 1), the residuals themselves carry
+    // all three.
+    let mut jtj = vec![0.0; p * p];
+    let mut raw_diagonal = vec![0.0; p];
+    let mut meat = vec![0.0; p * p];
+    let mut row = vec![0.0; p];
+    let mut dev_row = vec![0.0; p];
+    let mut score = vec![0.0; p];
+    for i in (0..problem.n()).filter(|&i| !problem.clipped[i]) {
+        let m = problem.model(st, i);
+        score.iter_mut().for_each(|x| *x = 0.0);
+        let mut any = false;
+        for (ch, (obs, model)) in problem.obs[i].iter().zip(m).enumerate() {
+            let r = *obs as f64 - model;
+            let d: f64 = (0..lights)
+                .map(|k| st.radiance[k][ch] * st.dev[k][i] as f64)
+                .sum();
+            for (a, param) in params.iter().enumerate() {
+                (row[a], dev_row[a]) = derivative(param, i, ch);
+                score[a] += r * row[a] + d * dev_row[a];
+                any |= row[a] != 0.0;
+            }
+            for a in 0..p {
+                if row[a] != 0.0 || dev_row[a] != 0.0 {
+                    raw_diagonal[a] += row[a] * row[a];
+                    for b in 0..p {
+                        jtj[a * p + b] += row[a] * row[b] - dev_row[a] * dev_row[b];
+                    }
+                }
+            }
+        }
+        if any {
+            for a in 0..p {
+                if score[a] != 0.0 {
+                    for b in 0..p {
+                        meat[a * p + b] += score[a] * score[b];
+                    }
+                }
+            }
+        }
+    }
+    // As in the fit (`solve_radiance`, the edge profiles): never trust less than half the
+    // raw curvature of a parameter.
+    for a in 0..p {
+        jtj[a * p + a] = jtj[a * p + a].max(0.5 * raw_diagonal[a]);
+    }
+    // A radiance channel nothing depends on (a light with no sample) stays solvable.
+    for a in 0..p {
+        jtj[a * p + a] += 1e-12 * (1.0 + jtj[a * p + a]);
+    }
+    let covariance = invert(&jtj, p).map(|inv| {
+        let product = |x: &[f64], y: &[f64]| {
+            let mut out = vec![0.0; p * p];
+            for a in 0..p {
+                for c in 0..p {
+                    let xa = x[a * p + c];
+                    if xa != 0.0 {
+                        for b in 0..p {
+                            out[a * p + b] += xa * y[c * p + b];
+                        }
+                    }
+                }
+            }
+            out
+        };
+        product(&product(&inv, &meat), &inv)
+    });
+    let mut out: Vec<Uncertainty> = (0..lights)
+        .map(|_| Uncertainty {
+            edges: [None; 4],
+            radiance: [f32::INFINITY; 3],
+        })
+        .collect();
+    if let Some(cov) = covariance {
+        for (a, param) in params.iter().enumerate() {
+            let var = cov[a * p + a];
+            let sd = if var.is_finite() && var >= 0.0 {
+                var.sqrt() as f32
+            } else {
+                f32::INFINITY
+            };
+            match param {
+                Param::Edge(k, side, ..) => out[*k].edges[*side as usize] = Some(sd),
+                Param::Radiance(k, ch) => out[*k].radiance[*ch] = sd,
+            }
+        }
+    }
+    out
+}
+
+/// Why an edge that faces another light split from the same start is reported unconstrained.
+pub(super) const FACING_REASON: &str =
+    "it faces another light split from the same streak: no streak edge \
+    shows it, and the fit places it only from where the two reflections overlap";
+
+/// Per light and edge (left, right, bottom, top), whether the edge faces another light split
+/// from the same start. The split lights' outer edges are the merged light's, measured from
+/// its streak's edge pixels; the facing ones were made by the cut, and the streak's edges say
+/// nothing about them. Two lights count as one above the other when their centres are
+/// further apart vertically than horizontally, each in units of the pair's summed size.
+pub(super) fn facing_edges(problem: &Problem, st: &State) -> Vec<[bool; 4]> {
+    let n = st.rects.len();
+    let origin = |k: usize| problem.set_origin[st.set_of[k]];
+    let mut out = vec![[false; 4]; n];
+    for (a, facing) in out.iter_mut().enumerate() {
+        for b in (0..n).filter(|&b| b != a && origin(b) == origin(a)) {
+            let (ra, rb) = (st.rects[a], st.rects[b]);
+            let du = (rb.u_min + rb.u_max - ra.u_min - ra.u_max) / (ra.width() + rb.width());
+            let dv = (rb.v_min + rb.v_max - ra.v_min - ra.v_max) / (ra.height() + rb.height());
+            let side = if dv.abs() >= du.abs() {
+                if dv > 0.0 {
+                    EdgeSide::Top
+                } else {
+                    EdgeSide::Bottom
+                }
+            } else if du > 0.0 {
+                EdgeSide::Right
+            } else {
+                EdgeSide::Left
+            };
+            facing[side as usize] = true;
+        }
+    }
+    out
+}
+
+/// Marks edges the joint fit found unconstrained (flat cost) as such, keeping the paper's
+/// reason where it had one.
+pub fn edge_statuses(light: &FittedLight, u: &Uncertainty) -> [EdgeStatus; 4] {
+    let mut out = light.edges.clone();
+    for side in EdgeSide::ALL {
+        if u.edges[side as usize].is_none()
+            && matches!(out[side as usize], EdgeStatus::Constrained { .. })
+        {
+            out[side as usize] = EdgeStatus::Unconstrained {
+                reason: "moving this edge does not change the modelled photo".into(),
+                unseen: false,
+            };
+        }
+    }
+    out
+}

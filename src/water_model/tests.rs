@@ -1,0 +1,129 @@
+//! A second water model plugs into the fitters unchanged: one that delegates to the exact
+//! surface (and counts that it was asked) gives the paper fit and the joint fit exactly the
+//! exact model's results.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use glam::{Vec2, Vec3};
+
+use super::{ExactSurface, WaterModel};
+use crate::fitting::joint::{fit_joint, fit_joint_with, JointOptions};
+use crate::fitting::{fit_paper, fit_paper_with, FitOptions, StreakObservation};
+use crate::optics::{LobeSample, ReflectionModel};
+use crate::render::WaterPoint;
+use crate::scene_in::Scene;
+
+/// The exact model behind another type, counting the questions it is asked.
+#[derive(Default)]
+struct Delegating {
+    water_points: AtomicUsize,
+    reflections: AtomicUsize,
+    directions: AtomicUsize,
+}
+
+impl WaterModel for Delegating {
+    fn water_point(
+        &self,
+        scene: &Scene,
+        x: f32,
+        y: f32,
+        width: u32,
+        height: u32,
+    ) -> Option<WaterPoint> {
+        self.water_points.fetch_add(1, Ordering::Relaxed);
+        ExactSurface.water_point(scene, x, y, width, height)
+    }
+
+    fn reflect(&self, point: &WaterPoint, model: &ReflectionModel, u: Vec2) -> Option<LobeSample> {
+        self.reflections.fetch_add(1, Ordering::Relaxed);
+        ExactSurface.reflect(point, model, u)
+    }
+
+    fn reflect_direction(
+        &self,
+        point: &WaterPoint,
+        model: &ReflectionModel,
+        u: Vec2,
+    ) -> Option<Vec3> {
+        self.directions.fetch_add(1, Ordering::Relaxed);
+        ExactSurface.reflect_direction(point, model, u)
+    }
+}
+
+#[test]
+fn a_delegating_model_gives_the_exact_models_fits() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!(
+        "streaklight-water-model-{}-{:?}",
+        std::process::id(),
+        std::thread::current().id()
+    ));
+    crate::samples::write_scenes(&dir).expect("sample scenes");
+    let scene = crate::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
+    let _ = std::fs::remove_dir_all(&dir);
+    let photo = crate::photo_in::load(
+        &root.join("samples/table1.png"),
+        crate::samples::PHOTO_EXPOSURE,
+    )
+    .expect("photo");
+    let water = crate::water_mask::water_mask(&scene, photo.width, photo.height);
+    let segmented =
+        crate::streaks::extract_streaks(&photo, &water, &Default::default()).expect("streaks");
+    let observations: Vec<StreakObservation> = segmented
+        .streaks
+        .iter()
+        .map(|s| crate::convert::observation(s, photo.width))
+        .collect();
+    let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
+    let options = FitOptions {
+        samples: 64,
+        seed: 1,
+        model,
+    };
+
+    let delegating = Delegating::default();
+    let exact = fit_paper(&scene, &photo, &water, &observations, &options).expect("paper fit");
+    let other = fit_paper_with(&delegating, &scene, &photo, &water, &observations, &options)
+        .expect("paper fit");
+    assert!(!exact.lights.is_empty(), "the paper fit finds the light");
+    assert_eq!(other.lights, exact.lights);
+    assert_eq!(other.skipped, exact.skipped);
+    assert!(delegating.water_points.load(Ordering::Relaxed) > 0);
+    assert!(delegating.reflections.load(Ordering::Relaxed) > 0);
+
+    let delegating = Delegating::default();
+    let joint_options = JointOptions {
+        samples: 8,
+        sweeps: 3,
+        split: false,
+        ..JointOptions::new(model, 1)
+    };
+    let exact_joint = fit_joint(
+        &scene,
+        &photo,
+        &water,
+        &observations,
+        &exact.lights,
+        &joint_options,
+    )
+    .expect("joint fit");
+    let other_joint = fit_joint_with(
+        &delegating,
+        &scene,
+        &photo,
+        &water,
+        &observations,
+        &exact.lights,
+        &joint_options,
+    )
+    .expect("joint fit");
+    assert_eq!(other_joint.lights, exact_joint.lights);
+    assert_eq!(other_joint.uncertainty, exact_joint.uncertainty);
+    assert_eq!(other_joint.pixels, exact_joint.pixels);
+    assert_eq!(other_joint.cost, exact_joint.cost);
+    // Every question of the joint fit went to the model: the region's probes, the samples
+    // and their cells, the control variates' grids.
+    assert!(delegating.water_points.load(Ordering::Relaxed) > 0);
+    assert!(delegating.reflections.load(Ordering::Relaxed) > 0);
+    assert!(delegating.directions.load(Ordering::Relaxed) > 0);
+}
