@@ -200,7 +200,8 @@ fn rendered(dir: &Path, photo: &str, spp: u32, cache: Option<&Path>) -> PathBuf 
         .find(|s| s.photo.as_deref() == Some(photo))
         .unwrap_or_else(|| panic!("{photo} is not a sample photo"));
     let t = std::time::Instant::now();
-    let image = samples::render_photo(dir, &spec, spp, Reporter::default()).expect("rendering the photo");
+    let image =
+        samples::render_photo(dir, &spec, spp, Reporter::default()).expect("rendering the photo");
     if let Some(cache) = cache {
         std::fs::create_dir_all(cache).expect("creating SPREAD_RENDER_CACHE");
     }

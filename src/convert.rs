@@ -8,8 +8,8 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::fitting::FittedLight;
-use crate::pipeline::{self, light_name, FitSettings, Input, Lit};
 use crate::photo_in::{self, Photo};
+use crate::pipeline::{self, light_name, FitSettings, Input, Lit};
 use crate::progress::Reporter;
 use crate::report::{self, Files, Report};
 use crate::scene_in::{self, AreaLight, LoadOptions, Scene};

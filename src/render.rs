@@ -363,4 +363,3 @@ fn pixel_sample(
     let inv = 1.0 / s.lobe_samples as f32;
     (sum.map(|c| c * inv), traced)
 }
-

@@ -264,8 +264,9 @@ impl Run<'_> {
     }
 
     /// The joint fit's options for `reading`.
-    fn joint_options(&self, j: &JointSettings, reading: Reading) -> JointOptions {
+    fn joint_options(&self, j: &JointSettings, reading: Reading) -> JointOptions<'_> {
         JointOptions {
+            progress: self.progress,
             repeats: j.repeats,
             samples: reading.samples,
             checkerboard: !reading.all_pixels,

@@ -72,7 +72,7 @@ fn a_delegating_model_gives_the_exact_models_fits() {
     let observations: Vec<StreakObservation> = segmented
         .streaks
         .iter()
-        .map(|s| crate::convert::observation(s, photo.width))
+        .map(|s| crate::pipeline::observation(s, photo.width))
         .collect();
     let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
     let options = FitOptions {

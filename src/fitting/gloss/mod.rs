@@ -88,6 +88,7 @@ use super::joint::{self, fit_joint, JointOptions, Uncertainty};
 use super::{fit_paper, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
+use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::{Error, Result};
 use search::{search, Point, Stop};
@@ -251,7 +252,10 @@ pub fn estimate_gloss(
     let t = Instant::now();
     let start_options = FitOptions {
         model: ReflectionModel {
-            gloss: paper.model.gloss.clamp(options.min_gloss, options.max_gloss),
+            gloss: paper
+                .model
+                .gloss
+                .clamp(options.min_gloss, options.max_gloss),
             ..paper.model
         },
         ..*paper
@@ -334,9 +338,9 @@ pub fn estimate_gloss(
     }
 
     // The lights at the estimate, fitted in full from the same start.
-    if let Some(say) = final_fit.progress {
-        say(&format!("gloss search: final joint fit at e = {gloss:.0}"));
-    }
+    final_fit
+        .progress
+        .stage(&format!("gloss search: final joint fit at e = {gloss:.0}"));
     let t = Instant::now();
     let final_fit = fit_joint(
         scene,
@@ -391,10 +395,10 @@ fn skipped_message(s: &Skipped) -> String {
 /// What the search's fits share: the start's model (the gloss varies), the seed, and whom
 /// to tell as each starts.
 #[derive(Clone, Copy)]
-struct SearchFit {
+struct SearchFit<'a> {
     model: ReflectionModel,
     seed: u64,
-    progress: Option<fn(&str)>,
+    progress: Reporter<'a>,
 }
 
 /// The gloss whose lobe picks the fitted pixels for every candidate: a quarter of the start
@@ -414,7 +418,7 @@ struct Cost<'a> {
     streaks: &'a [StreakObservation],
     start: &'a [FittedLight],
     options: &'a GlossSearch,
-    fit: SearchFit,
+    fit: SearchFit<'a>,
     /// (ln e, cost), in the order evaluated.
     evaluations: Vec<(f64, f64)>,
     /// Evaluations whose fit broke down (module doc), for a warning.
@@ -425,13 +429,11 @@ impl Cost<'_> {
     /// The cost at `x = ln e` as a point of the curve.
     fn point(&mut self, x: f64) -> Result<Point> {
         let gloss = x.exp() as f32;
-        if let Some(say) = self.fit.progress {
-            say(&format!(
-                "gloss search: joint fit {} of at most {}, at e = {gloss:.0}",
-                self.evaluations.len() + 1,
-                self.options.max_evaluations
-            ));
-        }
+        self.fit.progress.stage(&format!(
+            "gloss search: joint fit {} of at most {}, at e = {gloss:.0}",
+            self.evaluations.len() + 1,
+            self.options.max_evaluations
+        ));
         let fit = fit_joint(
             self.scene,
             self.photo,
@@ -469,4 +471,3 @@ impl Cost<'_> {
         })
     }
 }
-

@@ -45,18 +45,18 @@ impl Problem {
                     continue;
                 };
                 for side in EdgeSide::ALL {
-                    if st.pinned[k][side as usize] {
-                        windows[k][side as usize] = 0.0;
+                    if st.pinned[k][side] {
+                        windows[k][side] = 0.0;
                         continue;
                     }
-                    let half = windows[k][side as usize];
+                    let half = windows[k][side];
                     let cur = st.rects[k].edge(side);
                     let min_size = self.planes[st.set_of[k]].min_size;
                     let (lo, hi) = edge_bounds(&st.rects[k], side, &ext, min_size);
                     let a = (cur - half).max(lo);
                     let b = (cur + half).min(hi);
                     if b <= a {
-                        windows[k][side as usize] = MIN_WINDOW;
+                        windows[k][side] = MIN_WINDOW;
                         continue;
                     }
                     let step = (b - a) / (grid - 1) as f32;
@@ -82,7 +82,7 @@ impl Problem {
                     // travelling for several sweeps, and a window that shrank regardless
                     // would freeze it short of the optimum.
                     let moved = (t - cur).abs();
-                    windows[k][side as usize] = (half * WINDOW_SHRINK)
+                    windows[k][side] = (half * WINDOW_SHRINK)
                         .max(4.0 * moved)
                         .min(half)
                         .max(MIN_WINDOW);

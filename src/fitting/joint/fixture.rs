@@ -42,7 +42,7 @@ pub(super) fn table3_light0() -> Table3Light0 {
     let observations: Vec<StreakObservation> = segmented
         .streaks
         .iter()
-        .map(|s| crate::convert::observation(s, photo.width))
+        .map(|s| crate::pipeline::observation(s, photo.width))
         .collect();
     let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
     let options = crate::fitting::FitOptions {

@@ -78,6 +78,7 @@ use crate::fitting::rect::Rect;
 use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
+use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::water_model::{ExactSurface, WaterModel};
 use crate::{Error, Result};
@@ -111,7 +112,7 @@ use uncertainty::{facing_edges, uncertainties, FACING_REASON};
 
 /// How to refine.
 #[derive(Clone, Copy, Debug)]
-pub struct JointOptions {
+pub struct JointOptions<'a> {
     /// Lobe samples per pixel of the fitted region. The cost sums over thousands of pixels, so
     /// far fewer than the photo's own samples suffice.
     pub samples: u32,
@@ -140,14 +141,14 @@ pub struct JointOptions {
     /// fit); the mean's own error falls as one over the square root of
     /// the count.
     pub repeats: u32,
-    /// Told a line as each repeat starts, when there are several (None: silent).
-    pub progress: Option<fn(&str)>,
+    /// Told as each repeat starts, when there are several (silent by default).
+    pub progress: Reporter<'a>,
     /// Estimate the coefficients with the lobe Gaussian as a control variate (see the module
     /// doc): the same expectation, far less noise. Off only to measure what it brings.
     pub control_variate: bool,
 }
 
-impl JointOptions {
+impl JointOptions<'_> {
     /// Defaults for a model and seed.
     pub fn new(model: ReflectionModel, seed: u64) -> Self {
         JointOptions {
@@ -160,7 +161,7 @@ impl JointOptions {
             split: true,
             region_gloss: None,
             repeats: 1,
-            progress: None,
+            progress: Reporter::default(),
             control_variate: true,
         }
     }
@@ -330,13 +331,11 @@ pub fn fit_joint_with(
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
     for repeat in 1..options.repeats {
-        if let Some(say) = options.progress {
-            say(&format!(
-                "joint fit: repeat {} of {} (independent samples)",
-                repeat + 1,
-                options.repeats
-            ));
-        }
+        options.progress.stage(&format!(
+            "joint fit: repeat {} of {} (independent samples)",
+            repeat + 1,
+            options.repeats
+        ));
         let t = Instant::now();
         let mut again = problem_for(repeat);
         footprint_seconds += t.elapsed().as_secs_f64();
@@ -380,7 +379,7 @@ pub fn fit_joint_with(
     let mut uncertainty = uncertainties(&problem, &st, &extents);
     // The repeats' spread, where there are several, adds to the curvature's.
     for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
-        u.edges = [0, 1, 2, 3].map(|e| u.edges[e].map(|sd| sd.hypot(edges[e])));
+        u.edges = EdgeSide::ALL.map(|e| u.edges[e].map(|sd| sd.hypot(edges[e as usize])));
         u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
     }
     optimise_seconds += t2.elapsed().as_secs_f64();
@@ -391,8 +390,8 @@ pub fn fit_joint_with(
             let (r, rad) = (st.rects[k], st.radiance[k]);
             let mut edges = origin.edges.clone();
             for side in EdgeSide::ALL {
-                if facing[k][side as usize] {
-                    edges[side as usize] = EdgeStatus::Unconstrained {
+                if facing[k][side] {
+                    edges[side] = EdgeStatus::Unconstrained {
                         reason: FACING_REASON.into(),
                         unseen: false,
                     };

@@ -45,7 +45,7 @@ pub(super) fn uncertainties(
         let r = st.rects[k];
         let h = (0.02 * r.width().max(r.height())).max(0.005);
         for side in EdgeSide::ALL {
-            if st.pinned[k][side as usize] || extents[st.set_of[k]].is_none() {
+            if st.pinned[k][side] || extents[st.set_of[k]].is_none() {
                 continue;
             }
             let e = r.edge(side);
@@ -164,7 +164,7 @@ pub(super) fn uncertainties(
                 f32::INFINITY
             };
             match param {
-                Param::Edge(k, side, ..) => out[*k].edges[*side as usize] = Some(sd),
+                Param::Edge(k, side, ..) => out[*k].edges[*side] = Some(sd),
                 Param::Radiance(k, ch) => out[*k].radiance[*ch] = sd,
             }
         }
@@ -202,7 +202,7 @@ pub(super) fn facing_edges(problem: &Problem, st: &State) -> Vec<[bool; 4]> {
             } else {
                 EdgeSide::Left
             };
-            facing[side as usize] = true;
+            facing[side] = true;
         }
     }
     out
@@ -213,10 +213,8 @@ pub(super) fn facing_edges(problem: &Problem, st: &State) -> Vec<[bool; 4]> {
 pub fn edge_statuses(light: &FittedLight, u: &Uncertainty) -> [EdgeStatus; 4] {
     let mut out = light.edges.clone();
     for side in EdgeSide::ALL {
-        if u.edges[side as usize].is_none()
-            && matches!(out[side as usize], EdgeStatus::Constrained { .. })
-        {
-            out[side as usize] = EdgeStatus::Unconstrained {
+        if u.edges[side].is_none() && matches!(out[side], EdgeStatus::Constrained { .. }) {
+            out[side] = EdgeStatus::Unconstrained {
                 reason: "moving this edge does not change the modelled photo".into(),
                 unseen: false,
             };
