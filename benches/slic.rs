@@ -2,19 +2,16 @@
 //!
 //!     cargo bench --bench slic
 //!
-//! Images: synthetic shapes with noise (tests/common/shapes.rs) at 600 x 600, 1920 x 1080 and
+//! Images: synthetic shapes with noise (`streaklight::samples::shapes`) at 600 x 600, 1920 x 1080 and
 //! 4000 x 3000, K = N / 400, compactness 10, 10 iterations. Ours is timed with every core and
 //! with one; scikit-image (one core) through tests/python/slic_reference.py. Medians of a few
 //! runs after a warm-up. Set SLIC_BENCH_NO_PYTHON=1 to skip scikit-image.
-
-#[path = "../tests/common/shapes.rs"]
-#[allow(dead_code)]
-mod shapes;
 
 use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
+use streaklight::samples::shapes;
 use streaklight::streaks::superpixels::{slic, SlicParams};
 
 fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
@@ -62,15 +59,7 @@ fn main() {
         });
         let theirs = if use_python {
             let path = dir.join(format!("{w}x{h}.png"));
-            let rgb: Vec<u8> = img
-                .srgb
-                .iter()
-                .flat_map(|p| p.map(|c| (c * 255.0).round() as u8))
-                .collect();
-            image::RgbImage::from_raw(w, h, rgb)
-                .expect("image")
-                .save(&path)
-                .expect("write image");
+            img.rgb8().save(&path).expect("write image");
             let out = Command::new("python3")
                 .arg(&script)
                 .args(["time", path.to_str().expect("utf-8 path")])

@@ -6,8 +6,9 @@ mod common;
 
 use std::path::Path;
 
+use common::pipeline::{convert_options, sample_scenes_in};
 use glam::Vec3;
-use streaklight::convert::{convert, ConvertOptions};
+use streaklight::convert::convert;
 use streaklight::photo_in;
 use streaklight::render::{render, RenderOptions};
 use streaklight::report::LightReport;
@@ -16,11 +17,7 @@ use streaklight::scene_in::{self, LoadOptions};
 
 /// Fits `photo` against the sample scene in `dir` with the default method.
 fn fit(dir: &Path, photo: &Path, output: &str) -> LightReport {
-    let options = ConvertOptions {
-        exposure: samples::PHOTO_EXPOSURE,
-        ..ConvertOptions::new(dir.join("scene.gltf"), photo, dir.join(output))
-    };
-    let outcome = convert(&options).unwrap();
+    let outcome = convert(&convert_options(dir, photo, output)).unwrap();
     assert_eq!(outcome.report.lights.len(), 1, "{}", photo.display());
     outcome.report.lights[0].clone()
 }
@@ -80,8 +77,7 @@ impl Errors {
 
 #[test]
 fn exr_and_png_of_one_render_both_fit_table1_and_the_exr_is_no_worse() {
-    let dir = common::temp_dir("exr-fit");
-    samples::write_scenes(&dir).unwrap();
+    let dir = sample_scenes_in("exr-fit");
     let scene = scene_in::load(&dir.join("table1-truth.gltf"), &LoadOptions::default()).unwrap();
     let options = RenderOptions {
         width: samples::PHOTO_SIZE,

@@ -8,41 +8,15 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::fit_case::{self, EXPOSURE, SIDE};
-use common::gltf_check;
+use common::cli::{arg, fit_args};
+use common::dirs::listing;
+use common::fit_case::{self, SIDE};
+use common::json::read_json;
+use common::{gltf_check, validator};
 use serde_json::{json, Value};
 
-const EXPOSURE_ARG: &str = "0.1";
-
-/// Fewer lobe samples than the default keep every run to a second or two.
-const SAMPLES: &str = "64";
-
-fn s(p: &Path) -> String {
-    p.to_str().unwrap().to_owned()
-}
-
-/// The `fit` arguments for `scene`, `photo`, `out`, a report and `extra`.
-fn fit_args(scene: &Path, photo: &Path, out: &Path, report: &Path, extra: &[&str]) -> Vec<String> {
-    let mut args = vec![
-        "fit".to_owned(),
-        s(scene),
-        s(photo),
-        "-o".into(),
-        s(out),
-        "--report".into(),
-        s(report),
-        "--exposure".into(),
-        EXPOSURE_ARG.into(),
-        "--samples".into(),
-        SAMPLES.into(),
-    ];
-    args.extend(extra.iter().map(|a| a.to_string()));
-    args
-}
-
 fn run(args: &[String]) -> (bool, String) {
-    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (ok, _, stderr) = common::run_cli(&refs);
+    let (ok, _, stderr) = common::run_cli(args);
     assert!(!stderr.contains("panicked"), "panic on {args:?}: {stderr}");
     (ok, stderr)
 }
@@ -70,7 +44,7 @@ fn expect_refusal(
 }
 
 fn expect_refusal_to(dir: &Path, args: &[String], words: &[&str]) -> String {
-    let before = fit_case::listing(dir);
+    let before = listing(dir);
     let inputs: Vec<(PathBuf, Vec<u8>)> = before
         .iter()
         .map(|n| (dir.join(n), std::fs::read(dir.join(n)).unwrap_or_default()))
@@ -86,7 +60,7 @@ fn expect_refusal_to(dir: &Path, args: &[String], words: &[&str]) -> String {
         );
     }
     assert_eq!(
-        fit_case::listing(dir),
+        listing(dir),
         before,
         "a refused run left files behind (output, report or temporary): {stderr}"
     );
@@ -128,15 +102,15 @@ fn good_input_fits_a_light_and_validates() {
     let report = dir.join("report.json");
     let (ok, stderr) = run(&fit_args(&scene, &photo, &out, &report, &[]));
     assert!(ok, "{stderr}");
-    let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let r = read_json(&report);
     assert!(
         !r["lights"].as_array().unwrap().is_empty(),
         "no light fitted: {stderr}"
     );
     gltf_check::assert_keeps_everything(&scene, &out);
-    gltf_check::assert_validator_clean(&out);
+    validator::assert_validator_clean(&out);
     assert_eq!(
-        fit_case::listing(&dir),
+        listing(&dir),
         [
             "out.gltf",
             "out.streaklight.bin",
@@ -169,12 +143,12 @@ fn good_input_fits_a_light_and_validates() {
     ));
     assert!(ok, "{stderr}");
     assert!(stderr.contains("joint fit: repeat 2 of 2"), "{stderr}");
-    let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let r = read_json(&report);
     assert_eq!(r["settings"]["repeats"], 2);
     // 33 asked, rounded to two halves of 2 x 2 camera rays times 2 x 2 lobe samples.
     assert_eq!(r["settings"]["joint_samples"], 32);
     assert_eq!(r["settings"]["joint_pixels"], "all");
-    gltf_check::assert_validator_clean(&glb);
+    validator::assert_validator_clean(&glb);
 }
 
 #[test]
@@ -282,8 +256,8 @@ fn photos_without_streaks_are_refused_unless_allowed() {
     gltf_check::assert_keeps_everything(&scene, &out);
     let (a, b) = (gltf_check::load(&scene), gltf_check::load(&out));
     assert_eq!(a.json, b.json, "no light, yet the scene changed");
-    gltf_check::assert_validator_clean(&out);
-    let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    validator::assert_validator_clean(&out);
+    let r = read_json(&report);
     assert_eq!(r["lights"], json!([]));
 }
 
@@ -302,7 +276,7 @@ fn nothing_for_the_light_to_hang_on() {
     let stderr = fit_allowing_empty(&scene, &photo, &out, &dir.join("allowed.json"));
     assert!(stderr.contains("geometry"), "{stderr}");
     assert_eq!(gltf_check::load(&scene).json, gltf_check::load(&out).json);
-    gltf_check::assert_validator_clean(&out);
+    validator::assert_validator_clean(&out);
 }
 
 #[test]
@@ -370,7 +344,7 @@ fn read_only_output_folder_is_refused() {
     if as_root && !setpriv.exists() {
         eprintln!("skipped: root, and no setpriv to run as another user");
     } else {
-        let before = fit_case::listing(&dir);
+        let before = listing(&dir);
         let args = fit_args(
             &scene,
             &photo,
@@ -400,8 +374,8 @@ fn read_only_output_folder_is_refused() {
                 && stderr.contains("Permission denied"),
             "{stderr}"
         );
-        assert!(fit_case::listing(&ro).is_empty(), "{stderr}");
-        assert_eq!(fit_case::listing(&dir), before, "{stderr}");
+        assert!(listing(&ro).is_empty(), "{stderr}");
+        assert_eq!(listing(&dir), before, "{stderr}");
 
         // A read-only report folder: refused before the fit, so no scene is written without
         // its report (the scene's folder open to everyone, whoever runs the command).
@@ -409,7 +383,7 @@ fn read_only_output_folder_is_refused() {
         let open = dir.join("open");
         std::fs::create_dir(&open).unwrap();
         std::fs::set_permissions(&open, std::fs::Permissions::from_mode(0o777)).unwrap();
-        let before = fit_case::listing(&dir);
+        let before = listing(&dir);
         let args = fit_args(
             &scene,
             &photo,
@@ -422,9 +396,9 @@ fn read_only_output_folder_is_refused() {
             stderr.contains("report.json") && stderr.contains("Permission denied"),
             "{stderr}"
         );
-        assert!(fit_case::listing(&ro).is_empty(), "{stderr}");
-        assert!(fit_case::listing(&open).is_empty(), "{stderr}");
-        assert_eq!(fit_case::listing(&dir), before, "{stderr}");
+        assert!(listing(&ro).is_empty(), "{stderr}");
+        assert!(listing(&open).is_empty(), "{stderr}");
+        assert_eq!(listing(&dir), before, "{stderr}");
     }
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
@@ -433,7 +407,7 @@ fn read_only_output_folder_is_refused() {
     std::fs::create_dir(&taken).unwrap();
     let args = fit_args(&scene, &photo, &taken, &dir.join("report.json"), &[]);
     expect_refusal_to(&dir, &args, &["taken.gltf", "is a folder"]);
-    assert!(fit_case::listing(&taken).is_empty());
+    assert!(listing(&taken).is_empty());
     // A report path that is a folder: refused before the scene is written.
     let args = fit_args(&scene, &photo, &dir.join("out.gltf"), &taken, &[]);
     expect_refusal_to(&dir, &args, &["taken.gltf", "is a folder"]);
@@ -495,7 +469,7 @@ fn scene_problems_are_refused() {
     assert!(stderr.contains("non-finite (NaN"), "{stderr}");
     gltf_check::assert_keeps_everything(&nan_water, &out);
     // The input's NaN is the validator's only complaint; the output adds none.
-    gltf_check::assert_no_new_problems(&nan_water, &out);
+    validator::assert_no_new_problems(&nan_water, &out);
     for f in [
         "nanwater-out.gltf",
         "nanwater-out.streaklight.bin",
@@ -553,7 +527,7 @@ fn scene_problems_are_refused() {
 
 /// The report without its timings (the only part allowed to differ between runs).
 fn report_without_timings(path: &Path) -> Value {
-    let mut r: Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let mut r = read_json(path);
     r.as_object_mut().unwrap().remove("timings");
     // The output's path differs by the run's folder.
     r["files"].as_object_mut().unwrap().remove("output");
@@ -580,9 +554,9 @@ fn same_seed_same_bytes_whatever_the_thread_count() {
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let files = fit_case::listing(&sub);
+        let files = listing(&sub);
         assert!(files.iter().any(|f| f.ends_with(".bin")), "{files:?}");
-        gltf_check::assert_validator_clean(&out);
+        validator::assert_validator_clean(&out);
         gltf_check::assert_keeps_everything(&scene, &out);
         let bytes: Vec<(String, Vec<u8>)> = files
             .iter()
@@ -601,7 +575,6 @@ fn same_seed_same_bytes_whatever_the_thread_count() {
         "seeds 1 and 2 gave identical outputs"
     );
     assert_ne!(outputs[1].1["lights"], outputs[2].1["lights"]);
-    let _ = EXPOSURE;
 }
 
 /// `--debug-dir` writes the segment pictures and, side by side, the photo, the water
@@ -616,7 +589,7 @@ fn debug_dir_shows_photo_render_and_difference() {
     let report = dir.join("report.json");
     let mut args = fit_args(&scene, &photo, &out, &report, &[]);
     args.push("--debug-dir".into());
-    args.push(s(&debug));
+    args.push(arg(&debug));
     let (ok, stderr) = run(&args);
     assert!(ok, "{stderr}");
     for name in [

@@ -6,10 +6,9 @@
 //! streak's edge, which the edge solutions average over 100-300 pixels per edge.
 
 mod common;
-#[path = "common/fit_helpers.rs"]
-mod fit_helpers;
 
-use fit_helpers::*;
+use common::fit_helpers::fit_photo;
+use common::pipeline::{sample_photo, sample_scene};
 use glam::{DVec3, Vec3};
 use streaklight::fitting::footprint::footprint;
 use streaklight::fitting::{EdgeSide, EdgeStatus, FitOutcome, FittedLight, LightPlane, Rect};

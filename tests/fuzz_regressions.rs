@@ -3,9 +3,11 @@
 //! and the classes of bad input the loaders were hardened against. Each must give a clean
 //! `Err` with a message a person can act on: never a panic, an abort or a huge allocation.
 
+mod common;
+
 use std::path::Path;
 
-use base64::Engine;
+use common::gltf_builder::{data_uri, glb, vec3_bytes};
 use serde_json::{json, Value};
 use streaklight::scene_in::{load, load_from_bytes, LoadOptions};
 use streaklight::{photo_in, Error};
@@ -29,20 +31,9 @@ fn scene(bin: &[u8]) -> Value {
     })
 }
 
-fn data_uri(bin: &[u8]) -> String {
-    format!(
-        "data:application/octet-stream;base64,{}",
-        base64::engine::general_purpose::STANDARD.encode(bin)
-    )
-}
-
 /// Three vertices of a triangle on the water plane, then `extra` bytes.
 fn triangle_bin(extra: &[u8]) -> Vec<u8> {
-    let mut bin: Vec<u8> = [[-1.0f32, 0.0, -2.0], [1.0, 0.0, -2.0], [0.0, 0.0, -4.0]]
-        .iter()
-        .flatten()
-        .flat_map(|c| c.to_le_bytes())
-        .collect();
+    let mut bin = vec3_bytes(&[[-1.0, 0.0, -2.0], [1.0, 0.0, -2.0], [0.0, 0.0, -4.0]]);
     bin.extend_from_slice(extra);
     bin
 }
@@ -65,29 +56,11 @@ fn assert_scene_error(doc: &Value, expect: &str) {
     assert!(message.contains(expect), "{message:?} lacks {expect:?}");
 }
 
-fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut json = serde_json::to_vec(doc).unwrap();
-    json.resize(json.len().next_multiple_of(4), b' ');
-    let mut bin = bin.to_vec();
-    bin.resize(bin.len().next_multiple_of(4), 0);
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&((28 + json.len() + bin.len()) as u32).to_le_bytes());
-    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    out
-}
-
 fn glb_scene() -> Vec<u8> {
     let bin = triangle_bin(&[]);
     let mut doc = scene(&bin);
     doc["buffers"] = json!([{"byteLength": bin.len()}]);
-    glb(&doc, &bin)
+    glb(&doc, Some(&bin), &[])
 }
 
 #[test]

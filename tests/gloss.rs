@@ -3,35 +3,22 @@
 //! rendered with. Run in release mode: each estimate is a handful of joint fits.
 
 mod common;
-#[path = "common/fit_helpers.rs"]
-mod fit_helpers;
 
 use std::time::Instant;
 
-use fit_helpers::*;
+use common::pipeline::{
+    convert_options, observations, sample_photo, sample_photo_path, sample_scene, sample_scenes_in,
+    water,
+};
 use streaklight::fitting::gloss::{estimate_gloss, GlossEstimate, GlossSearch};
-use streaklight::fitting::StreakObservation;
-use streaklight::photo_in::Photo;
 use streaklight::samples;
 use streaklight::scene_in::Scene;
-use streaklight::streaks::{extract_streaks, StreakParams};
-use streaklight::water_mask::water_mask;
 use streaklight::Error;
-
-/// The real streak extraction's streaks as the fitter sees them (as `convert` makes them).
-fn observations(photo: &Photo, water: &[bool]) -> Vec<StreakObservation> {
-    let segmentation = extract_streaks(photo, water, &StreakParams::default()).unwrap();
-    segmentation
-        .streaks
-        .iter()
-        .map(|s| streaklight::convert::observation(s, photo.width))
-        .collect()
-}
 
 /// Estimates the gloss of a sample photo, starting from the scene's own gloss (500).
 fn estimate(scene: &Scene, photo_name: &str) -> (GlossEstimate, usize, f64) {
     let photo = sample_photo(photo_name);
-    let water = water_mask(scene, photo.width, photo.height);
+    let water = water(scene, &photo);
     let streaks = observations(&photo, &water);
     let t = Instant::now();
     let found = estimate_gloss(
@@ -116,7 +103,7 @@ fn estimates_the_gloss_of_the_sample_photos() {
 fn refuses_bad_input() {
     let scene = sample_scene("scene.gltf", None);
     let photo = sample_photo("table1.png");
-    let water = water_mask(&scene, photo.width, photo.height);
+    let water = water(&scene, &photo);
     let options = GlossSearch::for_scene(&scene);
 
     let none = estimate_gloss(&scene, &photo, &water, &[], &options).unwrap_err();
@@ -171,7 +158,7 @@ fn seed_spread() {
         .unwrap_or_else(|_| "gloss200.png table1.png gloss1000.png".into());
     for photo_name in photos.split_whitespace() {
         let photo = sample_photo(photo_name);
-        let water = water_mask(&scene, photo.width, photo.height);
+        let water = water(&scene, &photo);
         let streaks = observations(&photo, &water);
         for seed in seeds.split_whitespace().map(|s| s.parse::<u64>().unwrap()) {
             let mut options = GlossSearch::for_scene(&scene);
@@ -195,19 +182,12 @@ fn seed_spread() {
 #[test]
 fn gloss_auto_through_the_converter() {
     use streaklight::convert::{convert, ConvertOptions, Method};
-    let dir = std::env::temp_dir().join(format!("streaklight-gloss-auto-{}", std::process::id()));
-    samples::write_scenes(&dir).expect("sample scenes");
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = sample_scenes_in("gloss-auto");
     static LINES: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
     let options = ConvertOptions {
-        exposure: samples::PHOTO_EXPOSURE,
         estimate_gloss: true,
         progress: Some(|line| LINES.lock().unwrap().push(line.to_string())),
-        ..ConvertOptions::new(
-            dir.join("scene.gltf"),
-            root.join("samples/gloss1000.png"),
-            dir.join("out.gltf"),
-        )
+        ..convert_options(&dir, sample_photo_path("gloss1000.png"), "out.gltf")
     };
     let refused = convert(&ConvertOptions {
         method: Method::Paper,

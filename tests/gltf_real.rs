@@ -11,24 +11,11 @@ mod common;
 
 use std::path::Path;
 
-use common::{augment, fit_case, gltf_check};
-use serde_json::Value;
-
-const REAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gltf-real");
-
-fn real_files() -> Vec<std::path::PathBuf> {
-    let mut files: Vec<_> = std::fs::read_dir(REAL)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
-        .collect();
-    files.sort();
-    files
-}
-
-fn write_json(path: &Path, v: &Value) {
-    std::fs::write(path, serde_json::to_vec_pretty(v).unwrap()).unwrap();
-}
+use common::cli::fit_args;
+use common::gltf_builder::write_json;
+use common::gltf_check::{self, real_files, REAL};
+use common::json::read_json;
+use common::{augment, fit_case, validator};
 
 #[test]
 fn published_samples_keep_every_value_and_byte_through_fit() {
@@ -40,7 +27,7 @@ fn published_samples_keep_every_value_and_byte_through_fit() {
         let stem = original.file_stem().unwrap().to_str().unwrap();
         let sub = dir.join(stem);
         std::fs::create_dir(&sub).unwrap();
-        let published: Value = serde_json::from_slice(&std::fs::read(original).unwrap()).unwrap();
+        let published = read_json(original);
         let scene = sub.join("augmented.gltf");
         write_json(&scene, &augment::augment(&published, false));
         let truth = sub.join("truth.gltf");
@@ -50,23 +37,15 @@ fn published_samples_keep_every_value_and_byte_through_fit() {
 
         let out = sub.join("out.gltf");
         let report = sub.join("report.json");
-        let (ok, _, stderr) = common::run_cli(&[
-            "fit",
-            scene.to_str().unwrap(),
-            photo.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-            "--camera",
-            augment::CAMERA,
-            "--exposure",
-            "0.1",
-            "--samples",
-            "64",
-        ]);
+        let (ok, _, stderr) = common::run_cli(&fit_args(
+            &scene,
+            &photo,
+            &out,
+            &report,
+            &["--camera", augment::CAMERA],
+        ));
         assert!(ok, "{stem}: fit failed: {stderr}");
-        let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        let r = read_json(&report);
         assert!(
             !r["lights"].as_array().unwrap().is_empty(),
             "{stem}: no light fitted: {stderr}"
@@ -81,11 +60,11 @@ fn published_samples_keep_every_value_and_byte_through_fit() {
                 .is_some_and(|l| !l.is_empty()),
             "{stem}: no EXT_lights_area light in the output"
         );
-        gltf_check::assert_no_new_problems(original, &out);
+        validator::assert_no_new_problems(original, &out);
     }
     // Sanity: the validator baseline is as published (so "no new problems" means something).
     let count = |name: &str, severity_code: fn(&str) -> bool| -> usize {
-        gltf_check::validator_problems(&Path::new(REAL).join(name))
+        validator::validator_problems(&Path::new(REAL).join(name))
             .iter()
             .filter(|((code, _), _)| severity_code(code))
             .map(|(_, n)| n)

@@ -2,8 +2,13 @@
 //! extraction) on the committed sample photos, against the truth lights of `samples`, and
 //! against the paper method on the same photo (never against the fit's own output).
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use common::json::{read_json, schema_validator};
+use common::pipeline::{
+    convert_options, observations, sample_photo, sample_photo_path, sample_scene, sample_scenes,
+    sample_scenes_in, water,
+};
 use streaklight::convert::{convert, ConvertOptions, Method};
 use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
@@ -17,17 +22,6 @@ fn errors(light: &LightReport, truth: &SampleLight) -> ([f64; 4], f64) {
         .map(|i| (light.radiance[i] - truth.radiance[i]).abs() / peak)
         .fold(0.0, f64::max);
     (edges, rad)
-}
-
-/// The sample scenes, written once per test binary.
-fn scenes() -> PathBuf {
-    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    DIR.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("streaklight-joint-{}", std::process::id()));
-        samples::write_scenes(&dir).expect("sample scenes");
-        dir
-    })
-    .clone()
 }
 
 /// `streaklight fit` of a sample photo with a method; the report's lights.
@@ -52,22 +46,19 @@ fn fit_report_options(
     repeats: u32,
     joint_samples: Option<u32>,
 ) -> Report {
-    let dir = scenes();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let tag = format!(
         "{}-{}-{repeats}-{joint_samples:?}",
         photo.replace('.', "_"),
         method.name()
     );
     let options = ConvertOptions {
-        exposure: samples::PHOTO_EXPOSURE,
         method,
         repeats,
         joint_samples,
-        ..ConvertOptions::new(
-            dir.join("scene.gltf"),
-            root.join("samples").join(photo),
-            dir.join(format!("{tag}.gltf")),
+        ..convert_options(
+            sample_scenes(),
+            sample_photo_path(photo),
+            &format!("{tag}.gltf"),
         )
     };
     let report = convert(&options).expect("fit").report;
@@ -388,20 +379,17 @@ fn repeated_fits_cover_the_stacked_errors() {
 /// wording.
 #[test]
 fn stacked_lights_over_smooth_water_within_two_percent() {
-    let dir = scenes();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let run = |method: Method| {
         let options = ConvertOptions {
             load: streaklight::scene_in::LoadOptions {
                 gloss: Some(samples::STACKED_SMOOTH_GLOSS as f32),
                 ..Default::default()
             },
-            exposure: samples::PHOTO_EXPOSURE,
             method,
-            ..ConvertOptions::new(
-                dir.join("scene.gltf"),
-                root.join("samples/stacked1000.png"),
-                dir.join(format!("stacked1000-{}.gltf", method.name())),
+            ..convert_options(
+                sample_scenes(),
+                sample_photo_path("stacked1000.png"),
+                &format!("stacked1000-{}.gltf", method.name()),
             )
         };
         convert(&options).expect("fit").report
@@ -452,18 +440,11 @@ fn stacked_lights_over_smooth_water_within_two_percent() {
 /// uncertainties that matches the schema.
 #[test]
 fn joint_method_through_the_converter() {
-    let dir = std::env::temp_dir().join(format!("streaklight-joint-cli-{}", std::process::id()));
-    samples::write_scenes(&dir).expect("sample scenes");
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = sample_scenes_in("joint-cli");
     let options = ConvertOptions {
         report: Some(dir.join("report.json")),
-        exposure: samples::PHOTO_EXPOSURE,
         method: Method::Joint,
-        ..ConvertOptions::new(
-            dir.join("scene.gltf"),
-            root.join("samples/table1.png"),
-            dir.join("out.gltf"),
-        )
+        ..convert_options(&dir, sample_photo_path("table1.png"), "out.gltf")
     };
     let outcome = convert(&options).expect("joint fit");
     assert_eq!(outcome.report.settings.method, "joint");
@@ -500,13 +481,8 @@ fn joint_method_through_the_converter() {
         light.uncertainty.is_some(),
         "the joint fit reports uncertainties"
     );
-    let schema: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(root.join("schema/report.schema.json")).unwrap(),
-    )
-    .unwrap();
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
-    let validator = jsonschema::validator_for(&schema).unwrap();
+    let report = read_json(&dir.join("report.json"));
+    let validator = schema_validator("report.schema.json");
     assert!(validator.is_valid(&report));
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -524,7 +500,7 @@ fn joint_method_through_the_converter() {
 /// light's -1 / +2 / -2 %.
 #[test]
 fn stacked_lights_apart_never_become_a_sliver() {
-    let dir = scenes();
+    let dir = sample_scenes();
     let truth_path = dir.join("stacked-truth.gltf");
     let text = std::fs::read_to_string(&truth_path).expect("stacked truth scene");
     let mut doc: serde_json::Value = serde_json::from_str(&text).expect("stacked truth JSON");
@@ -542,19 +518,13 @@ fn stacked_lights_apart_never_become_a_sliver() {
         file: "stacked-apart-truth.gltf".into(),
         ..samples::by_photo("stacked.png").expect("the stacked sample")
     };
-    let rendered = samples::render_photo(&dir, &spec, samples::PHOTO_SPP, false).expect("render");
+    let rendered = samples::render_photo(dir, &spec, samples::PHOTO_SPP, false).expect("render");
     let photo = dir.join("stacked-apart.png");
     streaklight::photo_out::write(&photo, rendered.width, rendered.height, &rendered.pixels)
         .expect("write the photo");
-    let options = ConvertOptions {
-        exposure: samples::PHOTO_EXPOSURE,
-        ..ConvertOptions::new(
-            dir.join("scene.gltf"),
-            photo,
-            dir.join("stacked-apart-fit.gltf"),
-        )
-    };
-    let report = convert(&options).expect("fit").report;
+    let report = convert(&convert_options(dir, photo, "stacked-apart-fit.gltf"))
+        .expect("fit")
+        .report;
     assert!(!report.lights.is_empty(), "no light found");
     // The two streaks the paper merged and the joint fit split again make one warning, not
     // one per streak.
@@ -588,21 +558,10 @@ fn all_pixels_reads_the_whole_region() {
     use streaklight::fitting::joint::{fit_joint, JointOptions};
     use streaklight::fitting::{fit_paper, FitOptions};
     use streaklight::optics::ReflectionModel;
-    let dir = scenes();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let scene =
-        streaklight::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
-    let photo =
-        streaklight::photo_in::load(&root.join("samples/table1.png"), samples::PHOTO_EXPOSURE)
-            .expect("photo");
-    let water = streaklight::water_mask::water_mask(&scene, photo.width, photo.height);
-    let streaks = streaklight::streaks::extract_streaks(&photo, &water, &Default::default())
-        .expect("streaks");
-    let observations: Vec<_> = streaks
-        .streaks
-        .iter()
-        .map(|s| streaklight::convert::observation(s, photo.width))
-        .collect();
+    let scene = sample_scene("scene.gltf", None);
+    let photo = sample_photo("table1.png");
+    let water = water(&scene, &photo);
+    let observations = observations(&photo, &water);
     let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
     let paper = fit_paper(
         &scene,
@@ -640,12 +599,11 @@ fn all_pixels_reads_the_whole_region() {
     );
 
     let report = convert(&ConvertOptions {
-        exposure: samples::PHOTO_EXPOSURE,
         all_pixels: true,
-        ..ConvertOptions::new(
-            dir.join("scene.gltf"),
-            root.join("samples/table1.png"),
-            dir.join("table1-all-pixels.gltf"),
+        ..convert_options(
+            sample_scenes(),
+            sample_photo_path("table1.png"),
+            "table1-all-pixels.gltf",
         )
     })
     .expect("fit")

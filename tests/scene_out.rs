@@ -8,26 +8,19 @@ use std::path::{Path, PathBuf};
 
 mod common;
 
-use base64::Engine;
-use common::gltf_check::{load, resolve, validator_problems, Doc};
+use common::dirs::{sorted_paths, temp_dir};
+use common::gltf_builder::{data_uri, data_uri_of, f32_bytes, glb, GLB_BIN, GLB_JSON};
+use common::gltf_check::{assert_buffers_kept, load, real_files, resolve, Doc, REAL};
+use common::json::json_diff;
+use common::validator::{assert_no_new_problems_except, validator_problems};
 use glam::{DQuat, DVec3};
 use serde_json::{json, Value};
 use streaklight::scene_out::{
     write_lit_scene, BufferStorage, LightToWrite, NewData, WriteOptions, WriteSummary,
 };
 
-const REAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gltf-real");
-
 // ---------------------------------------------------------------------------------------------
 // Fixtures
-
-/// A fresh, empty folder for one test.
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("streaklight-so-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn two_lights() -> Vec<LightToWrite> {
     let n1 = DVec3::new(-1.0, -0.2, 0.3).normalize();
@@ -58,10 +51,7 @@ fn two_lights() -> Vec<LightToWrite> {
 /// A triangle: 3 positions (36 bytes) then 3 u16 indices (6 bytes); 42 bytes, so a GLB's BIN
 /// chunk needs padding and our data an aligned offset after it.
 fn triangle_bytes() -> Vec<u8> {
-    let mut b = Vec::new();
-    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
-        b.extend_from_slice(&v.to_le_bytes());
-    }
+    let mut b = f32_bytes(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     for i in [0u16, 1, 2] {
         b.extend_from_slice(&i.to_le_bytes());
     }
@@ -127,42 +117,7 @@ fn scene_json(buffer_uri: Option<&str>, image: Value) -> Value {
 }
 
 fn uv_bytes() -> Vec<u8> {
-    [0.0f32, 0.0, 1.0, 0.0, 0.0, 1.0]
-        .iter()
-        .flat_map(|v| v.to_le_bytes())
-        .collect()
-}
-
-fn data_uri(bytes: &[u8]) -> String {
-    format!(
-        "data:application/octet-stream;base64,{}",
-        base64::engine::general_purpose::STANDARD.encode(bytes)
-    )
-}
-
-fn glb(json: &Value, bin: Option<&[u8]>, extra: &[(u32, &[u8])]) -> Vec<u8> {
-    let mut text = serde_json::to_vec(json).unwrap();
-    text.resize(text.len().div_ceil(4) * 4, b' ');
-    let mut chunks: Vec<(u32, Vec<u8>)> = vec![(0x4E4F_534A, text)];
-    if let Some(bin) = bin {
-        let mut b = bin.to_vec();
-        b.resize(b.len().div_ceil(4) * 4, 0);
-        chunks.push((0x004E_4942, b));
-    }
-    for (kind, data) in extra {
-        chunks.push((*kind, data.to_vec()));
-    }
-    let total = 12 + chunks.iter().map(|(_, d)| 8 + d.len()).sum::<usize>();
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    for (kind, data) in chunks {
-        out.extend_from_slice(&(data.len() as u32).to_le_bytes());
-        out.extend_from_slice(&kind.to_le_bytes());
-        out.extend_from_slice(&data);
-    }
-    out
+    f32_bytes(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0])
 }
 
 /// The generated inputs, each in its own folder `dir/<name>/`, with any files it uses.
@@ -187,10 +142,7 @@ fn generated_inputs(dir: &Path) -> Vec<PathBuf> {
     inputs.push(p);
     // .gltf with data URIs only, no default scene, no extensionsUsed.
     let d = folder("embedded");
-    let png = format!(
-        "data:image/png;base64,{}",
-        base64::engine::general_purpose::STANDARD.encode(png_bytes())
-    );
+    let png = data_uri_of("image/png", &png_bytes());
     let mut json = scene_json(Some(&data_uri(&triangle_bytes())), json!({ "uri": png }));
     let root = json.as_object_mut().unwrap();
     root.remove("scene");
@@ -230,12 +182,7 @@ fn generated_inputs(dir: &Path) -> Vec<PathBuf> {
 
 /// Copies of the published samples, one folder each (the repository's copies stay untouched).
 fn real_inputs(dir: &Path) -> Vec<PathBuf> {
-    let mut names: Vec<PathBuf> = std::fs::read_dir(REAL)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
-        .collect();
-    names.sort();
+    let names = real_files();
     assert!(names.len() >= 9, "the samples in {REAL} are missing");
     names
         .iter()
@@ -274,51 +221,13 @@ fn positions(loaded: &Doc, count: usize) -> Vec<Vec<[f32; 3]>> {
 // ---------------------------------------------------------------------------------------------
 // The lossless check
 
-/// Walks input and output together. A key or array element only in the output is an
-/// "addition", a differing value a "change"; both are collected as JSON pointers.
-fn diff(a: &Value, b: &Value, at: &str, added: &mut Vec<String>, changed: &mut Vec<String>) {
-    match (a, b) {
-        (Value::Object(x), Value::Object(y)) => {
-            for (k, v) in x {
-                let p = format!("{at}/{k}");
-                match y.get(k) {
-                    Some(w) => diff(v, w, &p, added, changed),
-                    None => changed.push(format!("{p} (removed)")),
-                }
-            }
-            let keys: Vec<&String> = x.keys().filter(|k| y.contains_key(*k)).collect();
-            let kept: Vec<&String> = y.keys().filter(|k| x.contains_key(*k)).collect();
-            if keys != kept {
-                changed.push(format!("{at} (key order)"));
-            }
-            added.extend(
-                y.keys()
-                    .filter(|k| !x.contains_key(*k))
-                    .map(|k| format!("{at}/{k}")),
-            );
-        }
-        (Value::Array(x), Value::Array(y)) => {
-            for (i, v) in x.iter().enumerate() {
-                match y.get(i) {
-                    Some(w) => diff(v, w, &format!("{at}/{i}"), added, changed),
-                    None => changed.push(format!("{at}/{i} (removed)")),
-                }
-            }
-            added.extend((x.len()..y.len()).map(|i| format!("{at}/{i}")));
-        }
-        // `==` on serde_json numbers also tells 1 from 1.0.
-        _ if a == b => {}
-        _ => changed.push(at.to_string()),
-    }
-}
-
 /// Asserts that `output` holds all of `input`, changed only where the writer is meant to.
 fn assert_lossless(input: &Path, output: &Path, summary: &WriteSummary) {
     let a = load(input);
     let b = load(output);
-    let (mut added, mut changed) = (Vec::new(), Vec::new());
-    diff(&a.json, &b.json, "", &mut added, &mut changed);
-    for c in &changed {
+    // A key or array element only in the output is an addition, a differing value a change.
+    let diff = json_diff(&a.json, &b.json);
+    for c in &diff.changed {
         let ok = if let Some(rest) = c.strip_prefix("/buffers/") {
             let (i, field) = rest.split_once('/').unwrap();
             let i: usize = i.parse().unwrap();
@@ -357,6 +266,12 @@ fn assert_lossless(input: &Path, output: &Path, summary: &WriteSummary) {
         };
         assert!(ok, "{}: unexpected change at {c}", output.display());
     }
+    assert!(
+        diff.reordered.is_empty(),
+        "{}: unexpected change of key order at {:?}",
+        output.display(),
+        diff.reordered
+    );
     let top_arrays = [
         "nodes",
         "meshes",
@@ -368,7 +283,7 @@ fn assert_lossless(input: &Path, output: &Path, summary: &WriteSummary) {
         "extensionsUsed",
     ];
     let scene = summary.scene_index;
-    for p in &added {
+    for p in &diff.added {
         let parts: Vec<&str> = p.trim_start_matches('/').split('/').collect();
         let ok = match parts.as_slice() {
             [top] => top_arrays.contains(top) || *top == "extensions" || *top == "scene",
@@ -383,15 +298,12 @@ fn assert_lossless(input: &Path, output: &Path, summary: &WriteSummary) {
         assert!(ok, "{}: unexpected addition at {p}", output.display());
     }
     // Every input buffer is a prefix of the output's buffer of the same index.
-    assert!(b.buffers.len() >= a.buffers.len());
-    for (i, (x, y)) in a.buffers.iter().zip(&b.buffers).enumerate() {
-        assert!(y.starts_with(x), "{}: buffer {i} changed", output.display());
-    }
+    assert_buffers_kept(input, &a, output, &b);
     // Unknown GLB chunks survive a .glb output.
     if !b.glb_chunks.is_empty() {
         let unknown = |c: &[(u32, Vec<u8>)]| -> Vec<(u32, Vec<u8>)> {
             c.iter()
-                .filter(|(k, _)| *k != 0x4E4F_534A && *k != 0x004E_4942)
+                .filter(|(k, _)| *k != GLB_JSON && *k != GLB_BIN)
                 .cloned()
                 .collect()
         };
@@ -619,26 +531,14 @@ fn assert_matches_schema(output: &Path, summary: &WriteSummary) {
 /// `data:` URIs in a GLB (`DATA_URI_GLB`). Such a warning is accepted only where the output
 /// holds the very `data:` URI the input had.
 fn assert_valid(input: &Path, output: &Path) {
-    let before = validator_problems(input);
-    let mut after = validator_problems(output);
     let (a, b) = (load(input).json, load(output).json);
-    after.retain(|(code, pointer), _| {
-        let inherited = code == "DATA_URI_GLB"
+    assert_no_new_problems_except(input, output, |code, pointer| {
+        code == "DATA_URI_GLB"
             && a.pointer(pointer)
                 .and_then(Value::as_str)
                 .is_some_and(|u| u.starts_with("data:"))
-            && a.pointer(pointer) == b.pointer(pointer);
-        !inherited || before.contains_key(&(code.clone(), pointer.clone()))
+            && a.pointer(pointer) == b.pointer(pointer)
     });
-    let added: Vec<_> = after
-        .iter()
-        .filter(|(key, n)| before.get(*key).is_none_or(|m| *n > m))
-        .collect();
-    assert!(
-        added.is_empty(),
-        "{}: glTF-Validator errors/warnings the input did not have: {added:?}",
-        output.display()
-    );
 }
 
 /// Everything about one write.
@@ -955,11 +855,7 @@ fn assert_refused<T: std::fmt::Debug>(
             "message {message:?} should mention {w:?}"
         );
     }
-    let mut now: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    now.sort();
+    let now = sorted_paths(dir);
     assert_eq!(now, before, "files changed after: {message}");
 }
 
@@ -984,11 +880,7 @@ fn bad_inputs_are_refused_and_nothing_is_written() {
         "asset": { "version": "2.0" }, "buffers": [{ "byteLength": 42, "uri": "out.streaklight.bin" }]
     })).unwrap()).unwrap();
     std::fs::write(dir.join("out.streaklight.bin"), triangle_bytes()).unwrap();
-    let mut before: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    before.sort();
+    let before = sorted_paths(&dir);
     let lights = two_lights();
     let o = WriteOptions::default();
     let out = dir.join("out.gltf");

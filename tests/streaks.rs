@@ -6,19 +6,19 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use common::json::{read_json, schema_validator};
+use common::pipeline::{sample_photo, sample_photo_path, sample_scene, sample_scenes};
 use glam::{DVec3, Vec3};
-use streaklight::photo_in::{self, Photo};
+use streaklight::photo_in::Photo;
 use streaklight::random::Rng;
 use streaklight::samples::{self, SampleLight};
-use streaklight::scene_in::{self, LoadOptions, Scene};
+use streaklight::scene_in::Scene;
 use streaklight::streaks::{extract_streaks, BoundingBox, Segmentation, StreakParams, StreakSide};
 use streaklight::water_mask::water_mask;
 
 struct Setup {
-    dir: PathBuf,
     scene: Scene,
     water: Vec<bool>,
 }
@@ -26,23 +26,14 @@ struct Setup {
 fn setup() -> &'static Setup {
     static SETUP: OnceLock<Setup> = OnceLock::new();
     SETUP.get_or_init(|| {
-        let dir = common::temp_dir("streaks-samples");
-        samples::write_scenes(&dir).unwrap();
-        let scene = scene_in::load(&dir.join("scene.gltf"), &LoadOptions::default()).unwrap();
+        let scene = sample_scene("scene.gltf", None);
         let water = water_mask(&scene, 600, 600);
-        Setup { dir, scene, water }
+        Setup { scene, water }
     })
 }
 
-fn sample_photo(name: &str) -> Photo {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("samples")
-        .join(name);
-    photo_in::load(&path, samples::PHOTO_EXPOSURE).unwrap()
-}
-
 fn segment(photo: &Photo) -> Segmentation {
-    extract_streaks(photo, &setup().water, &StreakParams::default()).unwrap()
+    common::pipeline::segment(photo, &setup().water)
 }
 
 /// The pixel box where the mirror image of `light` in the water plane appears.
@@ -320,10 +311,9 @@ fn a_mask_of_the_wrong_size_or_without_water_is_refused() {
 
 #[test]
 fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
-    let s = setup();
     let out = common::temp_dir("segment-cli");
-    let photo = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/table3.png");
-    let scene = s.dir.join("scene.gltf");
+    let photo = sample_photo_path("table3.png");
+    let scene = sample_scenes().join("scene.gltf");
     let (ok, stdout, stderr) = common::run_cli(&[
         "segment",
         scene.to_str().unwrap(),
@@ -339,12 +329,8 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
         let img = image::open(out.join(name)).unwrap();
         assert_eq!((img.width(), img.height()), (600, 600));
     }
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("streaks.json")).unwrap()).unwrap();
-    let schema_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("schema/streaks.schema.json");
-    let schema: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(schema_path).unwrap()).unwrap();
-    let validator = jsonschema::validator_for(&schema).unwrap();
+    let report = read_json(&out.join("streaks.json"));
+    let validator = schema_validator("streaks.schema.json");
     let errors: Vec<String> = validator
         .iter_errors(&report)
         .map(|e| e.to_string())
@@ -357,7 +343,7 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
     assert!(!validator.is_valid(&broken));
 
     // No lights: the pictures and report are still written, and the command fails clearly.
-    let dark = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/dark.png");
+    let dark = sample_photo_path("dark.png");
     let out_dark = common::temp_dir("segment-cli-dark");
     let (ok, _, stderr) = common::run_cli(&[
         "segment",

@@ -3,12 +3,10 @@
 //! Quality measures as in davidstutz/superpixel-benchmark (lib_eval/evaluation.cpp):
 //! boundary recall with a tolerance of r pixels, and achievable segmentation accuracy.
 
-mod common;
-
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use common::shapes::{shapes, Shapes};
+use streaklight::samples::shapes::{shapes, Shapes};
 use streaklight::streaks::superpixels::{slic, SlicParams, Superpixels};
 
 /// A pixel is on a boundary when its right or lower neighbour is in another region.
@@ -282,15 +280,7 @@ fn regenerate_scikit_image_reference() {
     let dir = data_dir();
     std::fs::create_dir_all(&dir).unwrap();
     let img = shapes(480, 360, 30, 0.02, 11);
-    let rgb: Vec<u8> = img
-        .srgb
-        .iter()
-        .flat_map(|p| p.map(|c| (c * 255.0).round() as u8))
-        .collect();
-    image::RgbImage::from_raw(img.width, img.height, rgb)
-        .unwrap()
-        .save(dir.join("shapes.png"))
-        .unwrap();
+    img.rgb8().save(dir.join("shapes.png")).unwrap();
     let truth: Vec<u16> = img.truth.iter().map(|&t| t as u16).collect();
     image::ImageBuffer::<image::Luma<u16>, _>::from_raw(img.width, img.height, truth)
         .unwrap()

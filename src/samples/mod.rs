@@ -13,6 +13,7 @@
 //! Table 1's photo as linear float, from the same render as `table1.png` (large, so not
 //! committed).
 
+pub mod shapes;
 pub mod water_surface;
 
 use std::path::{Path, PathBuf};

@@ -2,10 +2,13 @@
 //! a wall (new nodes, meshes, a material, accessors, buffer views and a NEW buffer as a `data:`
 //! URI), leaving every existing value as it was. Optionally a truth light too, to render the
 //! photo from.
-#![allow(dead_code)]
 
-use base64::Engine;
 use serde_json::{json, Value};
+
+use super::gltf_builder::{
+    append_aligned, data_uri, flat_grid, push, push_area_light, u32_bytes, vec3_bounds, vec3_bytes,
+    WALL, WALL_INDICES,
+};
 
 /// The name of the camera node the augmentation adds (pass it as `--camera`).
 pub const CAMERA: &str = "StreaklightTestCamera";
@@ -13,17 +16,6 @@ pub const CAMERA: &str = "StreaklightTestCamera";
 /// Where the added setup sits: far enough along -Z that the original content (a few units
 /// around the origin) is behind the camera and out of the picture.
 const OFFSET: [f32; 3] = [0.0, 0.0, -60.0];
-
-fn push(doc: &mut Value, key: &str, value: Value) -> usize {
-    let root = doc.as_object_mut().expect("a glTF document is an object");
-    let arr = root
-        .entry(key)
-        .or_insert(json!([]))
-        .as_array_mut()
-        .expect("a glTF top-level array");
-    arr.push(value);
-    arr.len() - 1
-}
 
 /// Appends the setup to `original` (a parsed glTF document); with `light`, also a 3 x 3 m
 /// `EXT_lights_area` light of radiance 20 on the wall.
@@ -33,45 +25,28 @@ pub fn augment(original: &Value, light: bool) -> Value {
     let buffer = doc["buffers"].as_array().map_or(0, Vec::len);
     let mut views: Vec<(usize, usize, u32)> = Vec::new();
     let mut add_view = |bin: &mut Vec<u8>, bytes: &[u8], target: u32| {
-        while !bin.len().is_multiple_of(4) {
-            bin.push(0);
-        }
-        views.push((bin.len(), bytes.len(), target));
-        bin.extend_from_slice(bytes);
+        views.push((append_aligned(bin, bytes), bytes.len(), target));
         views.len() - 1
     };
-    let f32s =
-        |v: &[[f32; 3]]| -> Vec<u8> { v.iter().flatten().flat_map(|c| c.to_le_bytes()).collect() };
-    let u32s = |v: &[u32]| -> Vec<u8> { v.iter().flat_map(|c| c.to_le_bytes()).collect() };
     let shift = |v: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
         v.into_iter()
             .map(|p| [p[0] + OFFSET[0], p[1] + OFFSET[1], p[2] + OFFSET[2]])
             .collect()
     };
 
-    let (wp, wn, wi) = super::flat_grid(-12.0, 12.0, -1.0, 10.5, 24, 12, 0.0);
+    let (wp, wn, wi) = flat_grid(-12.0, 12.0, -1.0, 10.5, 24, 12, 0.0);
     let wp = shift(wp);
-    let wall = shift(vec![
-        [-40.0, -1.0, 0.0],
-        [40.0, -1.0, 0.0],
-        [40.0, 25.0, 0.0],
-        [-40.0, 25.0, 0.0],
-    ]);
-    let wall_i = [0u32, 1, 2, 0, 2, 3];
-    let v_wp = add_view(&mut bin, &f32s(&wp), 34962);
-    let v_wn = add_view(&mut bin, &f32s(&wn), 34962);
-    let v_wi = add_view(&mut bin, &u32s(&wi), 34963);
-    let v_lp = add_view(&mut bin, &f32s(&wall), 34962);
-    let v_li = add_view(&mut bin, &u32s(&wall_i), 34963);
+    let wall = shift(WALL.to_vec());
+    let v_wp = add_view(&mut bin, &vec3_bytes(&wp), 34962);
+    let v_wn = add_view(&mut bin, &vec3_bytes(&wn), 34962);
+    let v_wi = add_view(&mut bin, &u32_bytes(&wi), 34963);
+    let v_lp = add_view(&mut bin, &vec3_bytes(&wall), 34962);
+    let v_li = add_view(&mut bin, &u32_bytes(&WALL_INDICES), 34963);
 
-    let uri = format!(
-        "data:application/octet-stream;base64,{}",
-        base64::engine::general_purpose::STANDARD.encode(&bin)
-    );
     push(
         &mut doc,
         "buffers",
-        json!({"uri": uri, "byteLength": bin.len()}),
+        json!({"uri": data_uri(&bin), "byteLength": bin.len()}),
     );
     let view_index: Vec<usize> = views
         .iter()
@@ -83,19 +58,8 @@ pub fn augment(original: &Value, light: bool) -> Value {
             )
         })
         .collect();
-    let bounds = |v: &[[f32; 3]]| {
-        let mut min = [f32::INFINITY; 3];
-        let mut max = [f32::NEG_INFINITY; 3];
-        for p in v {
-            for c in 0..3 {
-                min[c] = min[c].min(p[c]);
-                max[c] = max[c].max(p[c]);
-            }
-        }
-        (min, max)
-    };
-    let (wmin, wmax) = bounds(&wp);
-    let (lmin, lmax) = bounds(&wall);
+    let (wmin, wmax) = vec3_bounds(&wp);
+    let (lmin, lmax) = vec3_bounds(&wall);
     let a_wp = push(
         &mut doc,
         "accessors",
@@ -159,18 +123,10 @@ pub fn augment(original: &Value, light: bool) -> Value {
         ),
     ];
     if light {
-        let root = doc.as_object_mut().unwrap();
-        let lights = root
-            .entry("extensions")
-            .or_insert(json!({}))
-            .as_object_mut()
-            .unwrap()
-            .entry("EXT_lights_area")
-            .or_insert(json!({"lights": []}))["lights"]
-            .as_array_mut()
-            .unwrap();
-        lights.push(json!({"name": "truth", "type": "rect", "color": [1.0, 1.0, 1.0], "intensity": 20.0, "size": 3.0, "rect": {"aspect": 1.0}}));
-        let index = lights.len() - 1;
+        let index = push_area_light(
+            &mut doc,
+            json!({"name": "truth", "type": "rect", "color": [1.0, 1.0, 1.0], "intensity": 20.0, "size": 3.0, "rect": {"aspect": 1.0}}),
+        );
         push(&mut doc, "extensionsUsed", json!("EXT_lights_area"));
         new_nodes.push(push(
             &mut doc,

@@ -1,6 +1,5 @@
 //! Small end-to-end `fit` cases: a paper-style scene, a truth light, and a photo of it rendered
 //! at low resolution, so the command line can be run in a test within seconds.
-#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 
@@ -80,16 +79,4 @@ pub fn good_case(dir: &Path) -> (PathBuf, PathBuf) {
     std::fs::remove_file(&truth).unwrap();
     super::paper_setup(Some(water_material())).write_gltf(&scene);
     (scene, photo)
-}
-
-/// The names of the files in `dir`, sorted.
-pub fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map(|rd| {
-            rd.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    names.sort();
-    names
 }

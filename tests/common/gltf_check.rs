@@ -1,13 +1,27 @@
-//! Checks on glTF outputs, independent of the writer: "every original value and byte is still
-//! there" and "the Khronos glTF-Validator finds nothing new".
-#![allow(dead_code)]
+//! Reading glTF outputs back independently of the writer, and the check "every original value
+//! and byte is still there"; the published sample files those checks run on.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use base64::Engine;
 use serde_json::Value;
+
+use super::gltf_builder::GLB_BIN;
+use super::json::json_diff;
+
+/// The published glTF samples (`tests/data/gltf-real`, see its README).
+pub const REAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gltf-real");
+
+/// The `.gltf` files of [`REAL`], sorted.
+pub fn real_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(REAL)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
+        .collect();
+    files.sort();
+    files
+}
 
 /// A document's JSON, the bytes of each of its buffers (data URIs, files, the BIN chunk), and
 /// for a .glb its chunks (type, bytes) as stored.
@@ -47,7 +61,7 @@ pub fn load(path: &Path) -> Doc {
         let json: Value = serde_json::from_slice(&chunks[0].1).unwrap();
         let bin = chunks
             .get(1)
-            .filter(|c| c.0 == 0x004E_4942)
+            .filter(|c| c.0 == GLB_BIN)
             .map(|c| c.1.clone());
         (json, bin, chunks)
     } else {
@@ -74,41 +88,29 @@ pub fn load(path: &Path) -> Doc {
     }
 }
 
-/// Every value of `a` is present and equal at the same path in `b` (objects may gain keys,
-/// arrays may gain trailing elements); returns the JSON pointers where it is not.
-pub fn missing_or_changed(a: &Value, b: &Value, at: &str, out: &mut Vec<String>) {
-    match (a, b) {
-        (Value::Object(x), Value::Object(y)) => {
-            for (k, v) in x {
-                match y.get(k) {
-                    Some(w) => missing_or_changed(v, w, &format!("{at}/{k}"), out),
-                    None => out.push(format!("{at}/{k} (removed)")),
-                }
-            }
-        }
-        (Value::Array(x), Value::Array(y)) => {
-            for (i, v) in x.iter().enumerate() {
-                match y.get(i) {
-                    Some(w) => missing_or_changed(v, w, &format!("{at}/{i}"), out),
-                    None => out.push(format!("{at}/{i} (removed)")),
-                }
-            }
-        }
-        // serde_json's `==` also tells 1 from 1.0.
-        _ if a == b => {}
-        _ => out.push(at.to_string()),
+/// Asserts that every buffer of `a` (read from `input`) is a prefix of the buffer of the same
+/// index of `b` (read from `output`).
+pub fn assert_buffers_kept(input: &Path, a: &Doc, output: &Path, b: &Doc) {
+    assert!(b.buffers.len() >= a.buffers.len());
+    for (i, (x, y)) in a.buffers.iter().zip(&b.buffers).enumerate() {
+        assert!(
+            y.starts_with(x),
+            "{}: buffer {i} of {} changed",
+            output.display(),
+            input.display()
+        );
     }
 }
 
-/// Asserts that `output` keeps every JSON value of `input` at the same path, and that every
-/// input buffer's bytes are a prefix of the output's buffer of the same index. Both files are
-/// expected to keep their buffers in the same form (a `.gltf` with `data:` buffers into a
-/// `.gltf`), so the `uri`s compare equal too.
+/// Asserts that `output` keeps every JSON value of `input` at the same path (objects may gain
+/// keys, arrays may gain trailing elements), and that every input buffer's bytes are a prefix
+/// of the output's buffer of the same index. Both files are expected to keep their buffers in
+/// the same form (a `.gltf` with `data:` buffers into a `.gltf`), so the `uri`s compare equal
+/// too.
 pub fn assert_keeps_everything(input: &Path, output: &Path) {
     let a = load(input);
     let b = load(output);
-    let mut diffs = Vec::new();
-    missing_or_changed(&a.json, &b.json, "", &mut diffs);
+    let mut diffs = json_diff(&a.json, &b.json).changed;
     // A `.gltf` -> `.gltf` write keeps even the data URIs; buffer 0 of a GLB grows.
     diffs.retain(|d| !(d == "/buffers/0/byteLength" && a.json["buffers"][0].get("uri").is_none()));
     // A relative URI may be rewritten to reach the same file from the output's folder.
@@ -118,13 +120,7 @@ pub fn assert_keeps_everything(input: &Path, output: &Path) {
         };
         let same_file = |v: &Value, doc: &Path| {
             let uri = v.pointer(&format!("/{rest}/uri"))?.as_str()?;
-            if uri.starts_with("data:") {
-                return None;
-            }
-            doc.parent()?
-                .join(streaklight::scene_in::document::percent_decode(uri))
-                .canonicalize()
-                .ok()
+            resolve(doc, uri)?.canonicalize().ok()
         };
         let (x, y) = (same_file(&a.json, input), same_file(&b.json, output));
         !(x.is_some() && x == y)
@@ -135,71 +131,10 @@ pub fn assert_keeps_everything(input: &Path, output: &Path) {
         output.display(),
         input.display()
     );
-    assert!(b.buffers.len() >= a.buffers.len());
-    for (i, (x, y)) in a.buffers.iter().zip(&b.buffers).enumerate() {
-        assert!(
-            y.starts_with(x),
-            "{}: buffer {i} of {} changed",
-            output.display(),
-            input.display()
-        );
-    }
+    assert_buffers_kept(input, &a, output, &b);
     assert_eq!(
         a.json.get("extensionsRequired"),
         b.json.get("extensionsRequired"),
         "extensionsRequired must not change"
-    );
-}
-
-/// The errors and warnings (code, JSON pointer) -> count the Khronos glTF-Validator reports.
-pub fn validator_problems(file: &Path) -> BTreeMap<(String, String), usize> {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/validator/validate.mjs");
-    let out = Command::new("node").arg(script).arg(file).output().unwrap_or_else(|e| {
-        panic!("cannot run `node` ({e}): install Node.js, then run `npm ci --prefix tests/validator`")
-    });
-    assert!(
-        out.status.success(),
-        "glTF-Validator on {} failed ({}): {} -- if the package is missing, run `npm ci --prefix tests/validator`",
-        file.display(),
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
-    let mut problems = BTreeMap::new();
-    for m in report["issues"]["messages"].as_array().unwrap() {
-        if m["severity"].as_u64().unwrap() <= 1 {
-            let key = (
-                m["code"].as_str().unwrap().to_string(),
-                m["pointer"].as_str().unwrap_or("").to_string(),
-            );
-            *problems.entry(key).or_insert(0) += 1;
-        }
-    }
-    problems
-}
-
-/// Asserts the validator reports no error and no warning at all.
-pub fn assert_validator_clean(file: &Path) {
-    let problems = validator_problems(file);
-    assert!(
-        problems.is_empty(),
-        "{}: glTF-Validator errors/warnings: {problems:?}",
-        file.display()
-    );
-}
-
-/// Asserts `output` has no validator error or warning that `input` did not have.
-pub fn assert_no_new_problems(input: &Path, output: &Path) {
-    let before = validator_problems(input);
-    let after = validator_problems(output);
-    let added: Vec<_> = after
-        .iter()
-        .filter(|(key, n)| before.get(*key).is_none_or(|m| *n > m))
-        .collect();
-    assert!(
-        added.is_empty(),
-        "{}: glTF-Validator errors/warnings {} did not have: {added:?}",
-        output.display(),
-        input.display()
     );
 }

@@ -1,7 +1,9 @@
-//! Synthetic images with known regions for the SLIC tests and benchmark: piecewise-constant
-//! colour shapes (rectangles, discs, triangles) painted over a background, plus Gaussian noise.
+//! Synthetic test images for the superpixel step (SLIC, `streaks::superpixels`): piecewise-
+//! constant colour shapes (rectangles, discs, triangles) painted over a background, plus
+//! Gaussian noise, with the true region of every pixel, so that a segmentation can be scored.
+//! The SLIC tests and the `slic` benchmark use them.
 
-use streaklight::random::Rng;
+use crate::random::Rng;
 
 /// An image and the region every pixel belongs to.
 pub struct Shapes {
@@ -11,6 +13,18 @@ pub struct Shapes {
     pub srgb: Vec<[f32; 3]>,
     /// The true region of every pixel.
     pub truth: Vec<u32>,
+}
+
+impl Shapes {
+    /// The image as 8-bit sRGB, as written to a file.
+    pub fn rgb8(&self) -> image::RgbImage {
+        let rgb: Vec<u8> = self
+            .srgb
+            .iter()
+            .flat_map(|p| p.map(|c| (c * 255.0).round() as u8))
+            .collect();
+        image::RgbImage::from_raw(self.width, self.height, rgb).expect("one colour per pixel")
+    }
 }
 
 /// The colour of region `r`: hues a golden angle apart and three lightness levels, so that no
