@@ -5,13 +5,16 @@
 mod common;
 
 use common::json::{read_json, schema_validator};
+use common::pipeline::fit_settings;
 use common::pipeline::{
     convert_options, observations, sample_photo, sample_photo_path, sample_scene, sample_scenes,
     sample_scenes_in, water,
 };
-use streaklight::convert::{convert, ConvertOptions, Method};
+use streaklight::convert::{convert, ConvertOptions};
+use streaklight::pipeline::Method;
 use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
+use streaklight::settings::Setting;
 
 /// Per edge (left, right, bottom, top), the error as a fraction of the light's size along
 /// that edge's axis; and the radiance error as a fraction of the largest channel.
@@ -52,9 +55,7 @@ fn fit_report_options(
         method.name()
     );
     let options = ConvertOptions {
-        method,
-        repeats,
-        joint_samples,
+        fit: fit_settings(method, repeats, joint_samples, false),
         ..convert_options(
             sample_scenes(),
             sample_photo_path(photo),
@@ -115,7 +116,7 @@ const LIGHT0_BOUND: f64 = 0.005;
 #[test]
 fn joint_fits_table1() {
     let truth = samples::table1_light();
-    let joint = fit("table1.png", Method::Joint);
+    let joint = fit("table1.png", Method::default());
     let paper = fit("table1.png", Method::Paper);
     assert_eq!(joint.len(), 1);
     let (je, jr) = errors(&joint[0], &truth);
@@ -157,7 +158,7 @@ fn joint_fits_table1() {
 #[test]
 fn joint_fits_table3() {
     let truths = samples::table3_lights();
-    let report = fit_report("table3.png", Method::Joint, 1);
+    let report = fit_report("table3.png", Method::default(), 1);
     // Two streaks, one light each: nothing to warn about overlapping reflections.
     assert!(
         report.warnings.iter().all(|w| !w.contains("overlap")),
@@ -239,7 +240,7 @@ fn joint_splits_overlapping_streaks() {
     let paper = fit_report("stacked.png", Method::Paper, 1);
     assert_eq!(paper.lights.len(), 1, "the paper method sees one light");
     assert_eq!(paper.settings.joint_samples, None, "no joint fit ran");
-    let report = fit_report("stacked.png", Method::Joint, 1);
+    let report = fit_report("stacked.png", Method::default(), 1);
     // The user is told that the two lights of one streak are weakly told apart.
     assert!(
         report
@@ -248,7 +249,7 @@ fn joint_splits_overlapping_streaks() {
             .any(|w| w.starts_with("streak 0 holds 2 lights")
                 && w.contains("streaklight_light_0, streaklight_light_1")
                 && w.contains("reported uncertainties")
-                && !w.contains("--all-pixels")),
+                && !w.contains(&Setting::AllPixels.to_string())),
         "{:?}",
         report.warnings
     );
@@ -329,7 +330,7 @@ fn repeated_fits_cover_the_stacked_errors() {
     let truths = samples::stacked_lights();
     // --joint-samples given: the user's choice stands (no refit over every pixel), and the
     // warning says which settings fit such lights more closely.
-    let report = fit_report_options("stacked.png", Method::Joint, 4, Some(72));
+    let report = fit_report_options("stacked.png", Method::default(), 4, Some(72));
     assert_eq!(
         report.settings.joint_pixels.as_deref(),
         Some("checkerboard")
@@ -339,7 +340,11 @@ fn repeated_fits_cover_the_stacked_errors() {
             .warnings
             .iter()
             .any(|w| w.starts_with("streak 0 holds 2 lights")
-                && w.contains("--all-pixels --joint-samples 128")),
+                && w.contains(&format!(
+                    "{}, {} 128",
+                    Setting::AllPixels,
+                    Setting::JointSamples
+                ))),
         "{:?}",
         report.warnings
     );
@@ -385,7 +390,7 @@ fn stacked_lights_over_smooth_water_within_two_percent() {
                 gloss: Some(samples::STACKED_SMOOTH_GLOSS as f32),
                 ..Default::default()
             },
-            method,
+            fit: fit_settings(method, 1, None, false),
             ..convert_options(
                 sample_scenes(),
                 sample_photo_path("stacked1000.png"),
@@ -399,7 +404,7 @@ fn stacked_lights_over_smooth_water_within_two_percent() {
         1,
         "the paper sees one light"
     );
-    let report = run(Method::Joint);
+    let report = run(Method::default());
     assert_eq!(report.settings.joint_pixels.as_deref(), Some("all"));
     let shared: Vec<&String> = report
         .warnings
@@ -408,7 +413,7 @@ fn stacked_lights_over_smooth_water_within_two_percent() {
         .collect();
     assert_eq!(shared.len(), 1, "{:?}", report.warnings);
     assert!(
-        !shared[0].contains("--all-pixels"),
+        !shared[0].contains(&Setting::AllPixels.to_string()),
         "no advice to use the settings already used: {}",
         shared[0]
     );
@@ -443,7 +448,7 @@ fn joint_method_through_the_converter() {
     let dir = sample_scenes_in("joint-cli");
     let options = ConvertOptions {
         report: Some(dir.join("report.json")),
-        method: Method::Joint,
+        fit: fit_settings(Method::default(), 1, None, false),
         ..convert_options(&dir, sample_photo_path("table1.png"), "out.gltf")
     };
     let outcome = convert(&options).expect("joint fit");
@@ -518,7 +523,8 @@ fn stacked_lights_apart_never_become_a_sliver() {
         file: "stacked-apart-truth.gltf".into(),
         ..samples::by_photo("stacked.png").expect("the stacked sample")
     };
-    let rendered = samples::render_photo(dir, &spec, samples::PHOTO_SPP, false).expect("render");
+    let rendered =
+        samples::render_photo(dir, &spec, samples::PHOTO_SPP, Default::default()).expect("render");
     let photo = dir.join("stacked-apart.png");
     streaklight::photo_out::write(&photo, rendered.width, rendered.height, &rendered.pixels)
         .expect("write the photo");
@@ -599,7 +605,7 @@ fn all_pixels_reads_the_whole_region() {
     );
 
     let report = convert(&ConvertOptions {
-        all_pixels: true,
+        fit: fit_settings(Method::default(), 1, None, true),
         ..convert_options(
             sample_scenes(),
             sample_photo_path("table1.png"),

@@ -202,11 +202,13 @@ mod tests {
                 ..
             }
         ));
-        let mut joint = JointSettings::default();
-        joint.overlap_refit = Some(Reading {
-            samples: 0,
-            all_pixels: true,
-        });
+        let joint = JointSettings {
+            overlap_refit: Some(Reading {
+                samples: 0,
+                all_pixels: true,
+            }),
+            ..JointSettings::default()
+        };
         let e = FitSettings {
             method: Method::Joint(joint),
             ..FitSettings::default()

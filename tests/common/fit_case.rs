@@ -52,7 +52,6 @@ pub fn render_photo_from(
             samples_per_pixel: spp,
             exposure: EXPOSURE,
             seed: 7,
-            progress: false,
             ..Default::default()
         },
     )

@@ -8,6 +8,7 @@ use std::sync::OnceLock;
 use streaklight::convert::ConvertOptions;
 use streaklight::fitting::StreakObservation;
 use streaklight::photo_in::{self, Photo};
+use streaklight::pipeline::{FitSettings, JointSettings, Method};
 use streaklight::samples;
 use streaklight::scene_in::{self, LoadOptions, Scene};
 use streaklight::streaks::{extract_streaks, Segmentation, StreakParams};
@@ -62,15 +63,39 @@ pub fn observations(photo: &Photo, water: &[bool]) -> Vec<StreakObservation> {
     segment(photo, water)
         .streaks
         .iter()
-        .map(|s| streaklight::convert::observation(s, photo.width))
+        .map(|s| streaklight::pipeline::observation(s, photo.width))
         .collect()
 }
 
 /// `convert` options that fit `photo` against the sample scene `dir/scene.gltf` into
 /// `dir/OUTPUT`, at the samples' exposure; everything else at its default.
-pub fn convert_options(dir: &Path, photo: impl Into<PathBuf>, output: &str) -> ConvertOptions {
+pub fn convert_options(
+    dir: &Path,
+    photo: impl Into<PathBuf>,
+    output: &str,
+) -> ConvertOptions<'static> {
     ConvertOptions {
         exposure: samples::PHOTO_EXPOSURE,
         ..ConvertOptions::new(dir.join("scene.gltf"), photo, dir.join(output))
+    }
+}
+
+/// Fit settings as `streaklight fit` makes them from `--method`, `--repeats`,
+/// `--joint-samples` and `--all-pixels` (the joint settings' own defaults otherwise).
+pub fn fit_settings(
+    method: Method,
+    repeats: u32,
+    joint_samples: Option<u32>,
+    all_pixels: bool,
+) -> FitSettings {
+    FitSettings {
+        method: match method {
+            Method::Paper => Method::Paper,
+            Method::Joint(j) => Method::Joint(JointSettings {
+                repeats,
+                ..j.reading_chosen(joint_samples, all_pixels)
+            }),
+        },
+        ..FitSettings::default()
     }
 }
