@@ -1,5 +1,5 @@
 //! The accuracy table: every case of the paper's Tables 1-3 fitted by `streaklight fit` on the
-//! committed sample photos, beside the truth and the paper's own results (METHOD §6).
+//! committed sample photos, beside the truth and the paper's own results (method §6).
 //! Run with `cargo bench --bench accuracy`; prints a Markdown table.
 
 use std::path::{Path, PathBuf};

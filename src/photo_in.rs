@@ -1,4 +1,4 @@
-//! Step 2 of METHOD.md §5: decode the photo into scene radiance, and mark clipped pixels.
+//! Step 2 of method §5: decode the photo into scene radiance, and mark clipped pixels.
 //!
 //! 8- and 16-bit images are sRGB-encoded and decoded with the exact sRGB curve; floating-point
 //! images (OpenEXR, Radiance HDR) are already linear. Both are divided by the exposure.
@@ -115,7 +115,7 @@ pub const MAX_PIXELS: u64 = 1 << 27;
 /// Most bytes the decoder may allocate for the image (2 GiB).
 pub const MAX_DECODE_BYTES: u64 = 2 << 30;
 
-/// Reads and decodes the photo at `path`; `exposure` divides the linear values (METHOD §2).
+/// Reads and decodes the photo at `path`; `exposure` divides the linear values (method §2).
 pub fn load(path: &Path, exposure: f32) -> Result<Photo> {
     check_exposure(exposure)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;

@@ -1,7 +1,7 @@
 //! Rendering the water under a scene's area lights: the forward model the fit inverts, used
 //! to make sample photos and to check a fit by re-rendering it.
 //!
-//! Per pixel, jittered camera rays integrate over the pixel's footprint (METHOD §2). A camera
+//! Per pixel, jittered camera rays integrate over the pixel's footprint (method §2). A camera
 //! ray that hits a light sees its radiance; one that hits the water samples the reflection
 //! lobe a few times and each reflected ray sees the light it reaches unoccluded, if any;
 //! everything else is black

@@ -2,7 +2,7 @@
 //! ray/triangle test (Woop, Benthin and Wald 2013).
 //!
 //! obvhs's own Möller-Trumbore test lets rays along shared edges of the water grid leak
-//! through (METHOD §8), which would show as bright dots where a reflected ray escapes the
+//! through (method §8), which would show as bright dots where a reflected ray escapes the
 //! water. The watertight test decides every edge consistently for both triangles that share
 //! it. Boxes are padded a little so that a hit exactly on a box face is not culled.
 
@@ -54,7 +54,7 @@ pub struct Hit {
 pub struct Tracer {
     bvh: Option<CwBvh>,
     /// Triangles reordered to the BVH's leaf order, so that the traversal's primitive id
-    /// indexes them directly (5-15 % faster than an indirection, METHOD §8).
+    /// indexes them directly (5-15 % faster than an indirection, method §8).
     ordered: Vec<Triangle>,
     /// For each entry of `ordered`, its index in the caller's list.
     original_index: Vec<u32>,
@@ -166,7 +166,7 @@ impl Tracer {
         }
         // The cheapest preset: on the sample scene (518k triangles, mostly the water's
         // regular grid) it builds in 0.32 s instead of medium's 0.56 s and traces as fast
-        // (reflected rays 6.51 against 6.44 M/s; BENCHMARKS.md, "Whole fit").
+        // (reflected rays 6.51 against 6.44 M/s; docs/decisions.md, "The BVH built with obvhs's `very_fast_build`").
         let bvh = build_cwbvh(
             triangles,
             BvhBuildParams::very_fast_build(),

@@ -1,4 +1,4 @@
-//! Step 2 of METHOD.md §5, second half: which pixels of the photo see the water.
+//! Step 2 of method §5, second half: which pixels of the photo see the water.
 
 use rayon::prelude::*;
 

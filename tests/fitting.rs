@@ -1,4 +1,4 @@
-//! Round trips of the fit (METHOD §5 steps 7-9) on the committed sample photos, whose truth
+//! Round trips of the fit (method §5 steps 7-9) on the committed sample photos, whose truth
 //! comes from `samples::table1_light()` and `samples::table3_lights()`, and a check of the
 //! fit's forward model against the renderer.
 //!

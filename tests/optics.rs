@@ -1,4 +1,4 @@
-//! Tests of the reflection model (METHOD.md §4) against quantities computed independently of
+//! Tests of the reflection model (method §4) against quantities computed independently of
 //! the library: the BRDF is re-derived here in f64 from its formula, and integrals are taken
 //! by deterministic quadrature in `wi` space, not by the library's sampler.
 
@@ -14,7 +14,7 @@ const IOR: f64 = 1.33;
 const LOST: f64 = 1e-3;
 
 // ---------------------------------------------------------------------------------------------
-// The model, written again from METHOD.md §4 and the doc comments, in f64.
+// The model, written again from method §4 and the doc comments, in f64.
 
 /// Fresnel from Snell's law and the s/p amplitude formulas (the library uses the
 /// Cook-Torrance closed form for the unpolarised value).

@@ -1,4 +1,4 @@
-//! Tests of the glTF writer (`streaklight::scene_out`, METHOD §7): nothing of the input is
+//! Tests of the glTF writer (`streaklight::scene_out`, method §7): nothing of the input is
 //! lost, the lights read back as written, the emitted extension matches its JSON Schema, and
 //! the Khronos glTF-Validator finds no new error or warning in any output.
 //!

@@ -1,4 +1,4 @@
-//! Streak extraction (METHOD §5 steps 3-6) on the sample photos of the paper's setup.
+//! Streak extraction (method §5 steps 3-6) on the sample photos of the paper's setup.
 //!
 //! The water mask comes from the sample scene (written into a temporary folder, since its
 //! water mesh is generated, not committed). Where a light's reflection falls is worked out from

@@ -1,4 +1,4 @@
-//! SLIC (METHOD §5 step 3) on synthetic images with known regions, and against scikit-image.
+//! SLIC (method §5 step 3) on synthetic images with known regions, and against scikit-image.
 //!
 //! Quality measures as in davidstutz/superpixel-benchmark (lib_eval/evaluation.cpp):
 //! boundary recall with a tolerance of r pixels, and achievable segmentation accuracy.

@@ -27,8 +27,8 @@ pub struct Args {
     #[arg(long)]
     pub debug_dir: Option<PathBuf>,
     /// Blinn-Phong gloss e of the water, overriding its material's roughness; or "auto" to
-    /// estimate it from the photo together with the lights (starting from the material's,
-    /// about 2-3 times slower).
+    /// estimate it from the photo together with the lights (starting from the material's;
+    /// several joint fits, so a few times slower). Not with --method paper.
     #[arg(long, value_name = "E|auto")]
     pub gloss: Option<GlossArg>,
     /// The photo's exposure: its linear values are divided by it to give radiance.
@@ -55,18 +55,16 @@ pub struct Args {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeats: u32,
     /// Lobe samples per pixel of the joint fit, rounded to 8 b^2 (8, 32, 72, 128, 200, 288,
-    /// ...; default 72, or 128 for the final fit of --gloss auto): the time grows with them,
-    /// the fit's own noise falls (Table 3's second light, seen only in part: top 0.56 % rms
-    /// at 72, 0.26 % at 288, about four times slower; beyond that the photo's own noise is
-    /// what is left). Without this option and --all-pixels, lights the fit finds sharing a
-    /// streak are fitted again over every pixel with 128 samples; with either, they are not.
+    /// ...; default 72, or 128 for the final fit of --gloss auto): the time grows with them
+    /// and the fit's own noise falls, until the photo's own noise is what is left. Without
+    /// this option and --all-pixels, lights the fit finds sharing a streak are fitted again
+    /// over every pixel with 128 samples; with either, they are not.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub joint_samples: Option<u32>,
     /// Fit every water pixel near the streaks instead of every second one (a checkerboard):
     /// about twice the joint fit's time, and less of both the samples' and the photo's noise
-    /// (Table 3's second light: top 0.36 % rms off instead of 0.56 %; more samples per pixel
-    /// cannot average the photo's noise). Lights sharing a streak get this by default (see
-    /// --joint-samples).
+    /// (more samples per pixel cannot average the photo's noise). Lights sharing a streak get
+    /// this by default (see --joint-samples).
     #[arg(long)]
     pub all_pixels: bool,
     /// Succeed and write the scene unchanged when no light is found.

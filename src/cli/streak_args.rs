@@ -2,7 +2,7 @@
 
 use streaklight::streaks::StreakParams;
 
-/// Streak-extraction options (METHOD §5 steps 3-5); the defaults work on the samples.
+/// Streak-extraction options (method §5 steps 3-5); the defaults work on the samples.
 #[derive(clap::Args)]
 pub struct StreakArgs {
     /// Number of superpixels K (default: one per 400 pixels).

@@ -1,4 +1,4 @@
-//! METHOD §5 step 9 (paper §4.3.2): one edge of the rectangle from the streak's edge pixels.
+//! method §5 step 9 (paper §4.3.2): one edge of the rectangle from the streak's edge pixels.
 //!
 //! A streak-edge pixel shows the coefficient `coef = I(p) / L`. Moving one edge of the
 //! rectangle (the other three held) changes `c(p; rect)` monotonically, so the edge position

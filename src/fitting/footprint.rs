@@ -1,4 +1,4 @@
-//! Per-pixel footprints on a light's plane (METHOD §5 step 9): for each pixel, where its
+//! Per-pixel footprints on a light's plane (method §5 step 9): for each pixel, where its
 //! lobe's sample rays land on the plane and with what weight. The reflection coefficient of the
 //! pixel for any rectangle on the plane is then a sum over the samples inside it, so the
 //! radiance and edge searches never trace a ray.

@@ -1,4 +1,4 @@
-//! Fragments of one light (METHOD §5 step 5): waves can break one light's streak into several
+//! Fragments of one light (method §5 step 5): waves can break one light's streak into several
 //! pieces. Pieces whose lights land on the same face and overlap are one light: their pixels are
 //! merged and the union is fitted again.
 

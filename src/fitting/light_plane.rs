@@ -1,4 +1,4 @@
-//! METHOD §5 step 7 (paper §4.2 step 3): the plane a light hangs on, found by casting the lobe's
+//! method §5 step 7 (paper §4.2 step 3): the plane a light hangs on, found by casting the lobe's
 //! rays at the streak's brightest pixel and taking the face most of them hit first.
 
 use glam::{Vec2, Vec3};

@@ -1,4 +1,4 @@
-//! Small dense linear algebra for the joint fit (METHOD §5, last paragraph): the nonnegative
+//! Small dense linear algebra for the joint fit (method §5, last paragraph): the nonnegative
 //! least squares of the radiances given the rectangles, and the inverse behind the
 //! uncertainties' covariance. The systems are small (one unknown per light for a channel's
 //! radiances, at most seven per light for the covariance), so plain elimination is all they

@@ -1,4 +1,4 @@
-//! Steps 7-9 of METHOD §5 (the paper's §4.2-4.3): for each streak, the plane its light hangs
+//! Steps 7-9 of method §5 (the paper's §4.2-4.3): for each streak, the plane its light hangs
 //! on, the light's radiance, and the rectangle's four edges.
 //!
 //! The forward model is exactly the renderer's ([`crate::render`]): a pixel is the mean over
@@ -282,7 +282,7 @@ pub(crate) fn check_sizes(photo: &Photo, water: &[bool]) -> Result<()> {
     Ok(())
 }
 
-/// Fits one rectangle light per streak (METHOD §5 steps 7-9), merging fragments of one light.
+/// Fits one rectangle light per streak (method §5 steps 7-9), merging fragments of one light.
 ///
 /// `water` is the water mask of the photo ([`crate::water_mask::water_mask`]); `streaks` come
 /// from the streak extraction. Fails only on inconsistent inputs (sizes that do not match);

@@ -14,15 +14,15 @@ pub struct StreakObservation {
     /// Every pixel of the streak.
     pub pixels: Vec<u32>,
     /// The brightest pixel of the streak's brightest superpixel: where the light plane is
-    /// searched (METHOD §5 step 7).
+    /// searched (method §5 step 7).
     pub brightest: u32,
-    /// Edge pixels of the streak on each of its sides in the image (METHOD §5 step 6),
+    /// Edge pixels of the streak on each of its sides in the image (method §5 step 6),
     /// indexed by [`StreakSide`].
     pub edges: StreakEdges,
 }
 
 impl StreakObservation {
-    /// Builds an observation from a streak's pixels: the edge pixels by METHOD §5 step 6
+    /// Builds an observation from a streak's pixels: the edge pixels by method §5 step 6
     /// ([`crate::streaks::edges::streak_edges`], as the extraction finds them), and the
     /// brightest pixel by the luminance of `radiance` (the streak extraction picks it per
     /// superpixel instead). The pixels are sorted, so every side lists its pixels in raster

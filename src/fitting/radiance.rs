@@ -1,4 +1,4 @@
-//! METHOD §5 step 8 (paper §4.2, eq. 7): the light's radiance, per RGB channel, from the
+//! method §5 step 8 (paper §4.2, eq. 7): the light's radiance, per RGB channel, from the
 //! streak's brightest pixels.
 //!
 //! The paper divides the brightest pixel by its coefficient with the whole plane lit. When

@@ -1,5 +1,5 @@
 //! A threshold segmentation of the photo into streaks: a simple stand-in for the streak
-//! extraction of METHOD §5 steps 3-6, used by tests and benchmarks of the fit.
+//! extraction of method §5 steps 3-6, used by tests and benchmarks of the fit.
 
 use super::observation::{luminance, StreakObservation};
 use crate::photo_in::Photo;

@@ -7,7 +7,7 @@ use super::lobe::ReflectionModel;
 use crate::random::Rng;
 
 /// Estimator of the reflection coefficient `c(p) = integral f(wo, wi) V(wi) (n.wi) dwi`
-/// (METHOD.md §4, paper eq. 11) over the truncation cone: the mean of `weight * visibility(wi)`
+/// (method §4, paper eq. 11) over the truncation cone: the mean of `weight * visibility(wi)`
 /// over `samples` lobe samples drawn with `rng`.
 ///
 /// `visibility` is called once for each sample that leaves above the surface, with its `wi`,

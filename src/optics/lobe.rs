@@ -8,7 +8,7 @@ use super::fresnel::fresnel_dielectric;
 use super::microfacet::{blinn_phong_d, cone_cos_theta, CONE_LOST_MASS};
 use super::shadowing::Shadowing;
 
-/// The reflection model of the water surface (METHOD.md §4): Blinn-Phong microfacets of gloss
+/// The reflection model of the water surface (method §4): Blinn-Phong microfacets of gloss
 /// `e`, a dielectric of index `ior` seen from air, and a choice of geometry term.
 ///
 /// Fields are public for convenience; `gloss` must be finite and >= 0 and `ior` > 0 (the

@@ -1,4 +1,4 @@
-//! The reflection model of METHOD.md §4: how a point of the water surface reflects the light of
+//! The reflection model of method §4: how a point of the water surface reflects the light of
 //! the lights towards the camera, and the importance sampler the renderer and the fitter share.
 //!
 //! Conventions: `n` is the unit surface normal (the interpolated vertex normal), `wo` the unit

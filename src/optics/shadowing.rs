@@ -2,7 +2,7 @@
 //! that only acts near grazing) or Smith shadowing-masking.
 
 /// Which geometry (shadowing-masking) term the reflection model uses. The renderer and the
-/// fitter must use the same one (METHOD.md §4).
+/// fitter must use the same one (method §4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Shadowing {
     /// The paper's `G = 1`, capped near grazing views so that energy is conserved:

@@ -1,4 +1,4 @@
-//! The sample scenes of the paper's setup (METHOD §6), generated deterministically.
+//! The sample scenes of the paper's setup (method §6), generated deterministically.
 //!
 //! Camera at (0, 0.2, 10) looking down -z, vertical fov 60 degrees, 600 x 600; a wall at
 //! z = 0 (or moved, for Table 2); a rippled water height field in front of it. The shared
@@ -53,8 +53,8 @@ pub const SAMPLE_GLOSSES: [f64; 2] = [200.0, 1000.0];
 /// but the lobes are narrower than over the default water, and the 256-spp photo pins the
 /// edges where the two lights meet to about 0.5 % of their heights (the fit's sigmas with
 /// every pixel and 576 samples), where over the default water (`stacked.png`) its own
-/// noise leaves them about 5 % uncertain, beyond what any fit can recover (BENCHMARKS.md,
-/// twelfth session).
+/// noise leaves them about 5 % uncertain, beyond what any fit can recover (the spread bench,
+/// BENCHMARKS.md).
 pub const STACKED_SMOOTH_GLOSS: f64 = 1000.0;
 
 /// A rectangle light on the wall, as the paper's tables give it.

@@ -1,4 +1,4 @@
-//! Rectangle lights already in a scene, in the `EXT_lights_area` shape of METHOD §7, so that a
+//! Rectangle lights already in a scene, in the `EXT_lights_area` shape of method §7, so that a
 //! lit scene can be rendered.
 //!
 //! A light is centred on its node's origin, its width along local X, its height along local

@@ -1,7 +1,7 @@
 //! The perspective camera the photo was taken with, and the rays through its pixels.
 //!
 //! Pixel (i = column, j = row, row 0 at the top) covers [i, i+1] x [j, j+1] in continuous
-//! pixel coordinates; its centre is (i + 0.5, j + 0.5) (METHOD §2).
+//! pixel coordinates; its centre is (i + 0.5, j + 0.5) (method §2).
 
 use glam::{DMat4, DVec3, Vec3};
 

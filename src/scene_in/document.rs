@@ -1,7 +1,7 @@
 //! Reading the bytes of a glTF scene: `.gltf` JSON or `.glb` container, and its buffers.
 //!
 //! The `gltf` crate's own loader refuses a valid scene whose `extensionsRequired` names an
-//! extension it does not know, and fails on `KHR_animation_pointer` (METHOD §7). This tool
+//! extension it does not know, and fails on `KHR_animation_pointer` (method §7). This tool
 //! reads only geometry, cameras and materials, so before handing the JSON to `gltf` for
 //! validation it removes the two things that can make it refuse for reasons that do not
 //! concern us: `extensionsRequired` and `animations`. The GLB container is parsed here

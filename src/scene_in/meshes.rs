@@ -1,7 +1,7 @@
 //! Every triangle of the scene, in the camera-centred frame.
 //!
 //! Positions are transformed to world space in f64 and only then recentred on the camera and
-//! rounded to f32: far from the origin f32 spacing is as large as a ripple (METHOD §5.1).
+//! rounded to f32: far from the origin f32 spacing is as large as a ripple (method §5 step 1).
 
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use serde_json::Value;

@@ -1,4 +1,4 @@
-//! Step 1 of METHOD.md §5: load the scene.
+//! Step 1 of method §5: load the scene.
 //!
 //! The node hierarchy is baked to world space in f64, recentred on the camera, and only then
 //! rounded to f32. Every triangle goes into one BVH ([`crate::tracing::Tracer`]).
@@ -29,13 +29,13 @@ use crate::{Error, Result};
 pub struct LoadOptions {
     /// Camera node or camera name; the first camera of the default scene if `None`.
     pub camera: Option<String>,
-    /// Water node or mesh name; found by name if `None` (METHOD §3).
+    /// Water node or mesh name; found by name if `None` (method §3).
     pub water: Option<String>,
     /// Gloss e overriding the water material's.
     pub gloss: Option<f32>,
     /// IOR overriding the water material's.
     pub ior: Option<f32>,
-    /// Divides light intensities to get radiance (METHOD §7).
+    /// Divides light intensities to get radiance (method §7).
     pub nits_scale: f64,
 }
 

@@ -1,4 +1,4 @@
-//! Which node is the water (METHOD §3), and its glossiness and index of refraction.
+//! Which node is the water (method §3), and its glossiness and index of refraction.
 
 use serde_json::Value;
 
@@ -175,7 +175,7 @@ mod tests {
 
     #[test]
     fn roughness_gloss_correspondence() {
-        // METHOD §3: r = 0.2512 gives e = 500.
+        // method §3: r = 0.2512 gives e = 500.
         assert!((gloss_from_roughness(0.2512) - 500.0).abs() < 1.0);
         for e in [50.0f32, 200.0, 500.0, 2000.0] {
             let back = gloss_from_roughness(roughness_from_gloss(e));

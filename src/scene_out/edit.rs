@@ -58,7 +58,7 @@ pub(crate) fn push(
 }
 
 /// Adds `name` to `extensionsUsed` unless it is listed already. `extensionsRequired` is never
-/// touched: viewers refuse files that require an extension they lack (METHOD §7).
+/// touched: viewers refuse files that require an extension they lack (method §7).
 pub(crate) fn use_extension(root: &mut Map<String, Value>, name: &str, input: &Path) -> Result<()> {
     let used = array_mut(root, "extensionsUsed", input)?;
     if !used.iter().any(|v| v.as_str() == Some(name)) {

@@ -1,4 +1,4 @@
-//! The fallback for viewers without area lights (METHOD §7): under each light node, an
+//! The fallback for viewers without area lights (method §7): under each light node, an
 //! emissive one-sided quad of the light's size, facing where the light emits, a little in
 //! front of the wall the light sits on ([`QUAD_LIFT`]).
 //!

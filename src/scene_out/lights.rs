@@ -1,4 +1,4 @@
-//! The `EXT_lights_area` JSON of a light (METHOD §7): the top-level light object, the node that
+//! The `EXT_lights_area` JSON of a light (method §7): the top-level light object, the node that
 //! places it, and the node's rotation from the light's frame.
 
 use glam::{DMat3, DQuat, DVec3};

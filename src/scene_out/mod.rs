@@ -1,4 +1,4 @@
-//! Step 10 of the pipeline (METHOD §5, §7): write the fitted lights into the user's glTF,
+//! Step 10 of the pipeline (method §5, §7): write the fitted lights into the user's glTF,
 //! losslessly.
 //!
 //! The document is edited as JSON: every existing key, value and index stays as it was, and

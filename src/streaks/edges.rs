@@ -1,4 +1,4 @@
-//! Step 6 of METHOD.md §5 (the paper's §3.2.3): the edge pixels of a streak.
+//! Step 6 of method §5 (the paper's §3.2.3): the edge pixels of a streak.
 //!
 //! Pixel p of a streak is a left-edge pixel when none of the three pixels to its left in the
 //! 3x3 around it belongs to the streak (pixels outside the image belong to no streak);

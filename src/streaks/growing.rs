@@ -1,4 +1,4 @@
-//! Step 5 of METHOD.md §5 (the paper's §3.2.2): growing streaks from seed superpixels by the
+//! Step 5 of method §5 (the paper's §3.2.2): growing streaks from seed superpixels by the
 //! correlation of their histograms (the paper's eq. 1).
 //!
 //! The histogram. The paper uses hue alone, which is undefined for the grey and white pixels of
@@ -16,7 +16,7 @@
 //!
 //! The correlation of two histograms is Pearson's over the bins; when either histogram is
 //! constant it is undefined, and we call the pair dissimilar (OpenCV's compareHist returns 1
-//! there, which merges every empty or flat superpixel; METHOD §5.5).
+//! there, which merges every empty or flat superpixel; method §5 step 5).
 //!
 //! The growth. Breadth-first from a seed superpixel over adjacent water superpixels. Departure
 //! from the paper: a candidate is compared with the streak superpixel it was reached from, not

@@ -1,4 +1,4 @@
-//! Steps 3-6 of METHOD.md §5 (the paper's §3): from a photo and its water mask to streaks.
+//! Steps 3-6 of method §5 (the paper's §3): from a photo and its water mask to streaks.
 //!
 //! [`extract_streaks`] runs superpixels ([`superpixels`]), seeds ([`seeds`]), growth
 //! ([`growing`]) and edges ([`edges`]); [`pictures`] draws every stage and [`report`] writes
@@ -9,7 +9,7 @@
 //!
 //! Fragments are not merged here: two fragments of one light (a wave breaking a streak) are
 //! told apart from two lights only by where their lights land in the scene, which the fitter
-//! knows (METHOD §5 step 5).
+//! knows (method §5 step 5).
 
 pub mod edges;
 pub mod growing;
@@ -72,7 +72,7 @@ pub struct Streak {
     /// The box around its pixels.
     pub bbox: BoundingBox,
     /// The brightest pixel (by luminance of the radiance) of its brightest superpixel (by mean
-    /// luminance), as (column, row): where METHOD §5 step 7 casts its rays.
+    /// luminance), as (column, row): where method §5 step 7 casts its rays.
     pub brightest: (u32, u32),
     /// Mean linear radiance (RGB) of its pixels.
     pub mean_colour: [f32; 3],

@@ -1,4 +1,4 @@
-//! Step 4 of METHOD.md §5 (the paper's §3.2.1): seed points and seed superpixels.
+//! Step 4 of method §5 (the paper's §3.2.1): seed points and seed superpixels.
 //!
 //! The photo is blurred, its HSV value V = max(R, G, B) taken (sRGB-encoded, as a person sees
 //! it), and every k-th row is mean-filtered and searched for peaks; a peak above t on the water

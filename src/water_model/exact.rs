@@ -1,5 +1,5 @@
 //! The exact-surface water model: the scene's water mesh is the photo's water, as in the
-//! paper's setting (METHOD §4), and exactly as the renderer ([`crate::render`]) makes a
+//! paper's setting (method §4), and exactly as the renderer ([`crate::render`]) makes a
 //! pixel: the camera ray's first hit on a water triangle, the mesh's interpolated shading
 //! normal as the lobe's axis, its face normal as the side the reflected rays stay on, and the
 //! renderer's offset off the surface.

@@ -1,4 +1,4 @@
-//! The forward model the fits invert (METHOD §4-5): how a pixel of the photo sees the water,
+//! The forward model the fits invert (method §4-5): how a pixel of the photo sees the water,
 //! and which way the water sends the light it reflects towards the camera.
 //!
 //! Every fitter builds its coefficients from the same two questions, and asks them here:
@@ -15,11 +15,11 @@
 //! scene's walls is the fitters' part: the water model says only how rays leave the water.
 //! Who asks:
 //!
-//! - the paper's estimate (METHOD §5 steps 7 and 9): the plane search
+//! - the paper's estimate (method §5 steps 7 and 9): the plane search
 //!   ([`crate::fitting::light_plane::find_plane`]) and the per-pixel footprints
 //!   ([`crate::fitting::footprint`]), one jittered camera ray per lobe sample
 //!   ([`crate::fitting::light_plane::reflected_sample`]);
-//! - the joint fit (METHOD §5, last paragraph): the pixels whose lobes reach a light
+//! - the joint fit (method §5, last paragraph): the pixels whose lobes reach a light
 //!   (`fitting::joint::region`, one ray from the pixel's centre and a grid of lobe
 //!   directions), the stored plane samples (`fitting::joint::samples`, stratified camera rays
 //!   each with a stratified set of lobe samples, and each sample's cell from its neighbours'

@@ -3,7 +3,7 @@
 //!
 //! The paper takes `e` as known. A wrong `e` does not stop a fit: the lights come out with
 //! the wrong size and radiance (a lobe that is too wide is answered by a light that is too
-//! small and too bright, METHOD §6), so `e` has to be measured too. What tells it apart is the
+//! small and too bright, method §6), so `e` has to be measured too. What tells it apart is the
 //! streak's profile: the width of the lobe sets how fast each edge of the streak fades, and a
 //! rectangle cannot mimic that at every edge at once. So `e` is the gloss whose best lights
 //! explain the photo best:

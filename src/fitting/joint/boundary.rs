@@ -1,4 +1,4 @@
-//! Overlapping streaks, METHOD §5 and the paper's §5.3: where two lights split from one
+//! Overlapping streaks, method §5 and the paper's §5.3: where two lights split from one
 //! meet. A global search over the boundary between them and their outer edges, since the
 //! split's coarse descent from the half cut cannot find it (see [`search_boundary`]).
 

@@ -1,4 +1,4 @@
-//! The joint fit's control variate (METHOD §5, last paragraph): a Gaussian on the light's
+//! The joint fit's control variate (method §5, last paragraph): a Gaussian on the light's
 //! plane per pixel, whose mass inside any rectangle is known exactly, subtracted from the lobe
 //! samples and added back in closed form.
 //!
@@ -19,7 +19,7 @@
 //!
 //! On Table 3 the noise of a coefficient's derivative by an edge is about a fifth in variance
 //! of the plain estimate's, and the fit's errors what 16 times the samples give without it
-//! (BENCHMARKS.md, "A control variate for the coefficients").
+//! (docs/decisions.md, "A control variate for the joint fit's coefficients").
 
 use glam::{Vec2, Vec3};
 

@@ -1,10 +1,10 @@
-//! The joint fit's cost and its radiances (METHOD §5, last paragraph): the residual sum of
+//! The joint fit's cost and its radiances (method §5, last paragraph): the residual sum of
 //! squares over the fitted pixels, less the coefficients' own noise, and the nonnegative
 //! least squares of the radiances given the rectangles.
 //!
 //! The model is linear in the radiances: given the rectangles they are a nonnegative least
 //! squares solve per channel ([`Problem::solve_radiance`]). A clipped pixel only counts when
-//! the model is below it (it is a lower bound, METHOD §2).
+//! the model is below it (it is a lower bound, method §2).
 //!
 //! # The noise of the coefficients, and why the fit must remove it
 //!

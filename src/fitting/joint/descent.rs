@@ -1,4 +1,4 @@
-//! The joint fit's coordinate descent (METHOD §5, last paragraph): every free edge in turn,
+//! The joint fit's coordinate descent (method §5, last paragraph): every free edge in turn,
 //! each step a global search on a grid of positions that shrinks around the best.
 //!
 //! Each 1-D step evaluates the cost on a whole grid of edge positions in one pass over the

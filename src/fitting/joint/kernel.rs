@@ -1,4 +1,4 @@
-//! The joint fit's sample kernels (METHOD §5, last paragraph): the cells, and why each stored
+//! The joint fit's sample kernels (method §5, last paragraph): the cells, and why each stored
 //! sample is spread over a kernel.
 //!
 //! A coefficient is the lobe's mass inside a rectangle. Counted as points, the samples near an

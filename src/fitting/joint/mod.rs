@@ -1,4 +1,4 @@
-//! Joint refinement of all lights by render and compare (METHOD §5, last paragraph).
+//! Joint refinement of all lights by render and compare (method §5, last paragraph).
 //!
 //! The paper fits each streak alone from its edge pixels. Here every water pixel from which
 //! a light can be seen counts, and all lights are fitted together: minimise
@@ -8,7 +8,7 @@
 //! ```
 //!
 //! where a clipped pixel only counts when the model is below it (it is a lower bound,
-//! METHOD §2). The fitted region is the streaks, dilated, plus every pixel near them whose
+//! method §2). The fitted region is the streaks, dilated, plus every pixel near them whose
 //! reflected rays can reach a light's region of interest: a streak's faint ends fall below
 //! any segmentation's threshold, and an edge seen only through them would otherwise drift
 //! (`region`).
@@ -360,7 +360,7 @@ pub fn fit_joint_with(
         // covers the errors (8 seeds through the pipeline: Table 3 0.5-1.3 sigma rms, largest
         // 2.1; the stacked sample 0.3-1.2, largest 1.8); adding the spread of two refits, one
         // from each half of the samples, would cost 0.7 s of Table 3's fit and only widen the
-        // sigmas further (BENCHMARKS.md, "A control variate for the coefficients").
+        // sigmas further (docs/decisions.md, "A control variate for the joint fit's coefficients").
         (first, None)
     } else {
         let (rects, radiance, spread) = mean_and_spread(&repeats);

@@ -1,4 +1,4 @@
-//! The joint fit's optimisation (METHOD §5, last paragraph): a descent from the start lights,
+//! The joint fit's optimisation (method §5, last paragraph): a descent from the start lights,
 //! then, for overlapping streaks, a split, a boundary search and another descent.
 //!
 //! Overlapping streaks (two lights whose reflections merge into one region, the paper's

@@ -1,4 +1,4 @@
-//! The joint fitting problem (METHOD §5, last paragraph): the fitted pixels, every light's
+//! The joint fitting problem (method §5, last paragraph): the fitted pixels, every light's
 //! stored samples, and the state of a fit (the lights' rectangles and radiances with the
 //! coefficients they give), kept up to date as one edge moves at a time.
 

@@ -1,4 +1,4 @@
-//! The cost along one edge (METHOD §5, last paragraph): the coordinate descent's 1-D step.
+//! The cost along one edge (method §5, last paragraph): the coordinate descent's 1-D step.
 //!
 //! [`Problem::edge_profile`] evaluates the cost on a whole grid of positions of one light's
 //! edge in one pass over the samples ([`super::ramps`]), with that light's radiance

@@ -1,4 +1,4 @@
-//! The joint fit's 1-D grid evaluation (METHOD §5, last paragraph): a pixel's coefficient at
+//! The joint fit's 1-D grid evaluation (method §5, last paragraph): a pixel's coefficient at
 //! every position of one edge on a grid, in one pass over its stored samples.
 //!
 //! The coordinate descent and the boundary search evaluate the cost on a whole grid of edge

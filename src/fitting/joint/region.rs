@@ -1,4 +1,4 @@
-//! The joint fit's region (METHOD §5, last paragraph): which pixels of the photo are fitted,
+//! The joint fit's region (method §5, last paragraph): which pixels of the photo are fitted,
 //! and where on its plane each light's edges may go.
 //!
 //! The fitted region is the streaks, dilated, plus every pixel near them whose reflected rays

@@ -1,4 +1,4 @@
-//! Repeated joint fits (METHOD §5, last paragraph): independent fits, each from its own
+//! Repeated joint fits (method §5, last paragraph): independent fits, each from its own
 //! samples, combined into their mean and the standard error of that mean (`--repeats`).
 
 use crate::fitting::rect::Rect;

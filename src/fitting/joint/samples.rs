@@ -1,4 +1,4 @@
-//! The joint fit's stored plane samples (METHOD §5, last paragraph): each fitted pixel's
+//! The joint fit's stored plane samples (method §5, last paragraph): each fitted pixel's
 //! coefficient integrated over its footprint as the renderer does it, from samples traced
 //! once.
 //!
@@ -336,8 +336,8 @@ fn shuffle(items: &mut [u32], rng: &mut Rng) {
 /// included, from the few samples near it), so its coefficients are noise out of all
 /// proportion to their size, and the fit, which subtracts the estimated noise from its cost,
 /// rewards exactly that: two stacked lights 1.8 m apart came out as the lower light and a
-/// 1 mm sliver at 1400 times the radiance, at a cost 90 below the truth's (BENCHMARKS.md,
-/// "A sliver of light"). A real light narrower than the bound (a strip light) comes out this
+/// 1 mm sliver at 1400 times the radiance, at a cost 90 below the truth's (docs/decisions.md, "No light
+/// thinner than its samples' kernels"). A real light narrower than the bound (a strip light) comes out this
 /// wide, with the radiance that keeps its reflection; more samples per pixel make the kernels,
 /// and the bound, smaller.
 pub(super) fn smallest_light(cells: &[Vec2]) -> Vec2 {

@@ -1,4 +1,4 @@
-//! Overlapping streaks, METHOD §5 and the paper's §5.3: whether one light is better
+//! Overlapping streaks, method §5 and the paper's §5.3: whether one light is better
 //! explained as two, and which way to cut it (see [`super::optimise`](mod@super::optimise)). Where the two lights
 //! meet is [`super::boundary`]'s work.
 
@@ -17,7 +17,7 @@ const SPLIT_TRIAL_SWEEPS: u32 = 8;
 const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
 
 /// Tries to explain light k as two lights on its plane, side by side or one above the other
-/// (overlapping streaks merge into one region, METHOD §5 and the paper's §5.3): each
+/// (overlapping streaks merge into one region, method §5 and the paper's §5.3): each
 /// candidate starts from the rectangle cut in half and is fitted coarsely. Returns the
 /// candidate with the lowest row-summed cost when it is below
 /// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, and the two edges that face each

@@ -1,4 +1,4 @@
-//! The joint fit's uncertainties and edge statuses (METHOD §5, last paragraph): one-sigma
+//! The joint fit's uncertainties and edge statuses (method §5, last paragraph): one-sigma
 //! uncertainties of every light's edges and radiances from the curvature of the cost the fit
 //! minimises, and which edges the photo does not determine.
 
@@ -79,7 +79,7 @@ pub(super) fn uncertainties(
     // derivatives as curvature (E[J_est J_est^T] = J J^T + their variance), so along a
     // direction the photo barely constrains (Table 3's light1: its height against its
     // radiance) it claims several times the real curvature and the sigmas come out small
-    // (BENCHMARKS.md, "Uncertainties: the curvature of the cost the fit minimises"). The noise is far from uniform (a streak's bright pixels carry most
+    // (docs/decisions.md, "Uncertainties: the curvature of the noise-corrected cost"). The noise is far from uniform (a streak's bright pixels carry most
     // of it, the dark surroundings none), the three channels of a pixel share it (a white
     // light), and the stored samples add their own: a single variance sigma^2 for all would
     // understate the errors tenfold (measured on Table 1), the residuals themselves carry

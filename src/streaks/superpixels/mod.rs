@@ -1,5 +1,5 @@
-//! Step 3 of METHOD.md §5: SLIC superpixels (Achanta et al. 2012), written here rather than
-//! taken from a crate (METHOD §9: the Rust crates are buggy or unmaintained).
+//! Step 3 of method §5: SLIC superpixels (Achanta et al. 2012), written here rather than
+//! taken from a crate (method §9: the Rust crates are buggy or unmaintained).
 //!
 //! We follow EPFL's reference code (SLIC.cpp, `PerformSLICO_ForGivenK` without the SLICO
 //! adaptive compactness, i.e. the original `PerformSuperpixelSLIC`):
@@ -17,7 +17,7 @@
 //! Departures from EPFL: a centre that loses all its pixels stays where it was (EPFL moves it
 //! to (0, 0) with colour zero, a division guard that became behaviour); centre sums are taken in
 //! fixed point (Lab x 256, integers) so that the result is the same bytes whatever the thread
-//! count (METHOD §2, determinism).
+//! count (method §2, determinism).
 //!
 //! Parallelism: the image is split into bands of rows (assign.rs); each band visits the centres
 //! whose window touches it in index order, so every pixel sees the same sequence of comparisons
