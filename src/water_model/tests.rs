@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 
 use super::{ExactSurface, WaterModel};
 use crate::fitting::joint::{fit_joint, fit_joint_with, JointOptions};
-use crate::fitting::{fit_paper, fit_paper_with, FitOptions, StreakObservation};
+use crate::fitting::{fit_paper, fit_paper_with, FitOptions};
 use crate::optics::{LobeSample, ReflectionModel};
 use crate::render::WaterPoint;
 use crate::scene_in::Scene;
@@ -52,28 +52,7 @@ impl WaterModel for Delegating {
 
 #[test]
 fn a_delegating_model_gives_the_exact_models_fits() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = std::env::temp_dir().join(format!(
-        "streaklight-water-model-{}-{:?}",
-        std::process::id(),
-        std::thread::current().id()
-    ));
-    crate::samples::write_scenes(&dir).expect("sample scenes");
-    let scene = crate::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
-    let _ = std::fs::remove_dir_all(&dir);
-    let photo = crate::photo_in::load(
-        &root.join("samples/table1.png"),
-        crate::samples::PHOTO_EXPOSURE,
-    )
-    .expect("photo");
-    let water = crate::water_mask::water_mask(&scene, photo.width, photo.height);
-    let segmented =
-        crate::streaks::extract_streaks(&photo, &water, &Default::default()).expect("streaks");
-    let observations: Vec<StreakObservation> = segmented
-        .streaks
-        .iter()
-        .map(|s| crate::pipeline::observation(s, photo.width))
-        .collect();
+    let (scene, photo, water, observations) = crate::samples::fixture("table1.png");
     let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
     let options = FitOptions {
         samples: 64,

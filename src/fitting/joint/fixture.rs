@@ -22,28 +22,7 @@ pub(super) struct Table3Light0 {
 }
 
 pub(super) fn table3_light0() -> Table3Light0 {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = std::env::temp_dir().join(format!(
-        "streaklight-joint-{}-{:?}",
-        std::process::id(),
-        std::thread::current().id()
-    ));
-    crate::samples::write_scenes(&dir).expect("sample scenes");
-    let scene = crate::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
-    let _ = std::fs::remove_dir_all(&dir);
-    let photo = crate::photo_in::load(
-        &root.join("samples/table3.png"),
-        crate::samples::PHOTO_EXPOSURE,
-    )
-    .expect("photo");
-    let water = crate::water_mask::water_mask(&scene, photo.width, photo.height);
-    let segmented =
-        crate::streaks::extract_streaks(&photo, &water, &Default::default()).expect("streaks");
-    let observations: Vec<StreakObservation> = segmented
-        .streaks
-        .iter()
-        .map(|s| crate::pipeline::observation(s, photo.width))
-        .collect();
+    let (scene, photo, water, observations) = crate::samples::fixture("table3.png");
     let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
     let options = crate::fitting::FitOptions {
         samples: 256,
