@@ -517,8 +517,8 @@ pub(crate) fn fixture(
     write_scenes(&dir).expect("sample scenes");
     let scene = crate::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
     let _ = std::fs::remove_dir_all(&dir);
-    let photo = crate::photo_in::load(&root.join("samples").join(photo), PHOTO_EXPOSURE)
-        .expect("photo");
+    let photo =
+        crate::photo_in::load(&root.join("samples").join(photo), PHOTO_EXPOSURE).expect("photo");
     let water = crate::water_mask::water_mask(&scene, photo.width, photo.height);
     let segmented =
         crate::streaks::extract_streaks(&photo, &water, &Default::default()).expect("streaks");

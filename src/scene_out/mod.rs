@@ -23,7 +23,7 @@
 //! images stay as they are, and a `.glb` written from such a `.gltf` keeps those warnings.
 //!
 //! When the output goes to another folder than the input, relative buffer and image URIs are
-//! rewritten to reach the original files (see [`resources`]); nothing is copied.
+//! rewritten to reach the original files (see the `resources` module); nothing is copied.
 
 mod document;
 mod edit;
