@@ -1,4 +1,4 @@
-//! Issue 6 item 1: a real engine reads our lights. Babylon.js's own glTF loader (which imports
+//! A real engine reads our lights. Babylon.js's own glTF loader (which imports
 //! `EXT_lights_area`) loads a lit scene in headless Chromium; `tests/engines/babylon_check.mjs`
 //! checks the lights it created against the report, and this test checks its screenshots.
 //!
@@ -183,7 +183,7 @@ fn babylon_reads_the_lights_and_lights_the_water() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Issue 6 item 2: the three.js example's GLTFLoader plugin makes RectAreaLights that match the
+/// The three.js example's GLTFLoader plugin makes RectAreaLights that match the
 /// report, and the example page lights the water with them.
 #[test]
 fn threejs_example_plugin_makes_matching_rect_area_lights() {

@@ -1,6 +1,6 @@
-//! `streaklight fit` on bad input (issue 4): a clear message naming what is wrong, a non-zero
-//! exit, no panic, and no output, no report and no temporary file left behind. Also: a good
-//! run's output passes the Khronos glTF-Validator, and runs are deterministic (issue 6).
+//! `streaklight fit` on bad input: a clear message naming what is wrong, a non-zero exit, no
+//! panic, and no output, no report and no temporary file left behind. Also: a good run's
+//! output passes the Khronos glTF-Validator, and runs are deterministic.
 //!
 //! Needs `node` and `npm ci --prefix tests/validator` for the validator checks.
 

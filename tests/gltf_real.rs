@@ -1,4 +1,4 @@
-//! Issue 6 item 3: `fit` on glTF files we did not write loses nothing. Each published sample in
+//! `fit` on glTF files we did not write loses nothing. Each published sample in
 //! `tests/data/gltf-real/` gets a camera, a water plane and a wall appended
 //! (`common::augment`); a small photo of that scene with a truth light is rendered; `fit` then
 //! runs on the augmented scene without the light. The output must keep every JSON value of the

@@ -1,4 +1,4 @@
-//! The joint refinement (issue 5) through the whole pipeline (`convert`, real streak
+//! The joint refinement (`--method joint`, the default) through the whole pipeline (`convert`, real streak
 //! extraction) on the committed sample photos, against the truth lights of `samples`, and
 //! against the paper method on the same photo (never against the fit's own output).
 
@@ -104,11 +104,10 @@ fn percent(e: [f64; 4]) -> [f64; 4] {
 
 /// The joint fit's error is mostly its own footprints' Monte Carlo noise and the photo's.
 /// Measured through the whole pipeline with 8 seeds of the fit's samples on the committed
-/// Table 3 photo (`cargo bench --bench spread`, ninth session, with the control variate),
-/// the root mean square errors in % of the light's size, and the bounds held here, three
-/// times those (a fixed seed's result is one draw; the bounds must not rest on a lucky one):
-/// light0 worst edge 0.07 %, radiance 0.17 %: held to 0.5 %. (Without the control variate:
-/// 0.27 % and 0.29 %; before the samples were spread over kernels: 0.75 % and 0.82 %.)
+/// Table 3 photo (`cargo bench --bench spread`, BENCHMARKS.md), the root mean square errors
+/// in % of the light's size, and the bounds held here, three times those (a fixed seed's
+/// result is one draw; the bounds must not rest on a lucky one): light0 worst edge 0.07 %,
+/// radiance 0.17 %: held to 0.5 %.
 const LIGHT0_BOUND: f64 = 0.005;
 
 /// Table 1 (one light, fully in the photo): every edge and the radiance within
@@ -137,8 +136,7 @@ fn joint_fits_table1() {
     }
     assert!(jr < LIGHT0_BOUND, "radiance off by {:.3} %", 100.0 * jr);
     // The reported uncertainties (the curvature of the noise-corrected cost) cover the real
-    // errors: over 8 seeds light0's errors were 0.5-1.3 sigma rms, at most 2.1 (without the
-    // control variate, with refits from each half of the samples: 1.0-2.3, at most 4.3).
+    // errors: over 8 seeds light0's errors are 0.5-1.3 sigma rms, at most 2.1.
     let (se, sr) = sigmas(&joint[0], &truth);
     eprintln!("table1: errors in sigmas {se:?}, radiance {sr:.2}");
     assert!(
@@ -153,8 +151,7 @@ fn joint_fits_table1() {
 /// and reports it unconstrained. Its other edges and radiance are seen only through the
 /// 40-70 pixel wide strip left of the border, where height and radiance trade against each
 /// other, so the noise moves them more: rms over 8 seeds 0.05 % (left), 0.22 % (bottom),
-/// 0.56 % (top), 0.59 % (radiance) (without the control variate 0.06, 0.63, 1.17, 1.54 %);
-/// held to three times that, as light0.
+/// 0.56 % (top), 0.59 % (radiance); held to three times that, as light0.
 #[test]
 fn joint_fits_table3() {
     let truths = samples::table3_lights();
@@ -201,11 +198,8 @@ fn joint_fits_table3() {
         );
     }
     assert!(r1 < 0.018, "light1 radiance off by {:.3} %", 100.0 * r1);
-    // Uncertainties: both lights' errors within 5 sigma. Over 8 seeds the largest was 2.1
-    // sigma for light0 and 1.6 for light1 (without the control variate 2.8 and 1.5);
-    // light1's reached 6.9 while the curvature counted
-    // the samples' noise in the derivatives as curvature, and 12.8 with 2-sweep half refits
-    // (BENCHMARKS.md, seventh session).
+    // Uncertainties: both lights' errors within 5 sigma. Over 8 seeds the largest is 2.1
+    // sigma for light0 and 1.6 for light1 (`cargo bench --bench spread`, BENCHMARKS.md).
     let (s0, sr0) = sigmas(&joint[0], &truths[0]);
     let (s1, sr1) = sigmas(&joint[1], &truths[1]);
     eprintln!("table3: light0 errors in sigmas {s0:?} {sr0:.2}; light1 {s1:?} {sr1:.2}");
@@ -229,11 +223,11 @@ fn joint_fits_table3() {
 /// pixel with 128 samples. Through the whole pipeline (`cargo bench --bench spread`, 8 seeds)
 /// the side edges are within 0.1 % rms; the heights and radiances trade against each other
 /// through the overlap, and on this 256-spp photo the lower light's top is 4.8 % rms off and
-/// the upper one's bottom 5.1 % (9 and 11 % before the refit), without a common sign: as far
-/// as the photo's own noise moves them (the report's sigmas at 576 samples: 5 %). The
-/// reported sigmas cover them (0.3-1.3 rms). So the split, the refit, the side edges (held
-/// to 1 %), the sigmas and the order are held here; the issue's 2 % is held on
-/// `stacked1000.png`, whose photo resolves the lights (BENCHMARKS.md, twelfth session).
+/// the upper one's bottom 5.1 %, without a common sign: as far as the photo's own noise
+/// moves them (the report's sigmas at 576 samples: 5 %). The reported sigmas cover them
+/// (0.3-1.3 rms). So the split, the refit, the side edges (held to 1 %), the sigmas and the
+/// order are held here; the 2 % target is held on `stacked1000.png`, whose photo resolves
+/// the lights (`stacked_lights_over_smooth_water_within_two_percent`, BENCHMARKS.md).
 #[test]
 fn joint_splits_overlapping_streaks() {
     let truths = samples::stacked_lights();
@@ -300,8 +294,7 @@ fn joint_splits_overlapping_streaks() {
         );
         assert!(e[0].abs() < 0.01 && e[1].abs() < 0.01, "side edges {e:?}");
         // One fit's report says how doubtful these lights are: over seeds 1-8 their errors
-        // are at most 2.0 sigma (rms 0.5-0.9), where the curvature of the uncorrected cost
-        // had put them at up to 41.7 sigma (BENCHMARKS.md, seventh and tenth sessions).
+        // are at most 2.0 sigma (rms 0.5-0.9) (BENCHMARKS.md).
         assert!(
             z.iter().chain([&z_rad]).all(|&s| s < 6.0),
             "errors beyond 6 sigma: {z:?} {z_rad}"
@@ -321,10 +314,8 @@ fn joint_splits_overlapping_streaks() {
 /// the 4 fits from independent samples added to the uncertainties. The lower light's error
 /// through the overlap is a bias common to the fits (it grows into the overlap: top +11 %,
 /// radiance -10 % for seed 1), which no spread of them shows; it is the curvature of the
-/// noise-corrected cost that reports it (see `joint_splits_overlapping_streaks`, and
-/// BENCHMARKS.md, seventh session: before that, 4 repeats left the errors at 4-6 sigma rms
-/// over seeds 1-8 and one fit at 13-24). Held here: every parameter of both lights within 6
-/// sigma for the default seed.
+/// noise-corrected cost that reports it (see `joint_splits_overlapping_streaks`). Held
+/// here: every parameter of both lights within 6 sigma for the default seed.
 #[test]
 fn repeated_fits_cover_the_stacked_errors() {
     let truths = samples::stacked_lights();
@@ -377,8 +368,8 @@ fn repeated_fits_cover_the_stacked_errors() {
 /// still merge into one streak (the paper method fits one light), but narrower lobes let the
 /// photo pin the edges where the two lights meet. At the default settings the joint fit,
 /// having split the streak, fits again over every pixel with 128 samples, and both lights
-/// come out within the issue's 2 % for every edge and the radiance: over fit seeds 1-8
-/// (`cargo bench --bench spread`, BENCHMARKS.md twelfth session) the largest error of any
+/// come out within 2 % for every edge and the radiance: over fit seeds 1-8
+/// (`cargo bench --bench spread`, BENCHMARKS.md) the largest error of any
 /// parameter was 1.9 % (the lower light's radiance), rms 1.3 % or less. Held here for seed 1,
 /// with the report's sigmas (which the bench found covering the errors) and the warning's
 /// wording.
@@ -494,15 +485,14 @@ fn joint_method_through_the_converter() {
 
 /// Two stacked lights 1.8 m apart instead of the sample's 0.8 m: the upper light's reflection
 /// is cut by the photo's lower border and seen mostly through its blurred end. Its height is
-/// then weakly told, but a light thinner than the samples' kernels must not win: before the
-/// fit's smallest light (`smallest_light` in src/fitting/joint.rs), the default fit of this
-/// render made the upper light 1 mm tall at 1400 times the truth's radiance (19891), because
-/// a thin light's coefficients are nearly all sample noise and the fit subtracts estimated
-/// noise from its cost. Held: every light at least 0.2 m tall (the truth's 1.0 and 1.4 m; the
+/// then weakly told, but a light thinner than the samples' kernels must not win: a thin
+/// light's coefficients are nearly all sample noise and the fit subtracts estimated noise
+/// from its cost, so without the fit's smallest light (`smallest_light` in
+/// src/fitting/joint.rs) the upper light of this render comes out 1 mm tall at 1400 times the
+/// truth's radiance (19891). Held: every light at least 0.2 m tall (the truth's 1.0 and 1.4 m; the
 /// kernels' typical full height here is about 0.28 m) and its radiance within 4 times the
 /// truth's (14 and 16). Measured with the split's boundary search (seed 1): the upper light's
-/// bottom, top and radiance +5 / -6 / +12 % off (before it: +15 / -19 / +47 %), the lower
-/// light's -1 / +2 / -2 %.
+/// bottom, top and radiance +5 / -6 / +12 % off, the lower light's -1 / +2 / -2 %.
 #[test]
 fn stacked_lights_apart_never_become_a_sliver() {
     let dir = sample_scenes();

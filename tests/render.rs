@@ -2,6 +2,7 @@
 
 mod common;
 
+use common::threads::on_threads;
 use streaklight::render::{render, RenderOptions};
 use streaklight::scene_in::load;
 
@@ -21,13 +22,7 @@ fn same_seed_same_image_on_one_and_two_threads() {
         seed: 9,
         ..Default::default()
     };
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| render(&scene, &options).unwrap())
-    };
+    let run = |threads: usize| on_threads(threads, || render(&scene, &options).unwrap());
     let one = run(1);
     let two = run(2);
     assert_eq!(one.pixels, two.pixels);

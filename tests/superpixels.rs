@@ -3,9 +3,12 @@
 //! Quality measures as in davidstutz/superpixel-benchmark (lib_eval/evaluation.cpp):
 //! boundary recall with a tolerance of r pixels, and achievable segmentation accuracy.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use common::threads::on_threads;
 use streaklight::samples::shapes::{shapes, Shapes};
 use streaklight::streaks::superpixels::{slic, SlicParams, Superpixels};
 
@@ -162,11 +165,9 @@ fn slic_does_not_depend_on_the_thread_count() {
         ..SlicParams::default()
     };
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| slic(img.width, img.height, &img.srgb, &params).unwrap())
+        on_threads(threads, || {
+            slic(img.width, img.height, &img.srgb, &params).unwrap()
+        })
     };
     let one = run(1);
     let three = run(3);

@@ -20,6 +20,9 @@ pub mod pipeline;
 /// Running the command line.
 pub mod cli;
 
+/// Running code on a given number of threads.
+pub mod threads;
+
 /// Small end-to-end `fit` cases (scene, truth light, rendered photo).
 pub mod fit_case;
 

@@ -1,4 +1,4 @@
-// Issue 6 item 1: a real engine reads our lights.
+// A real engine (Babylon.js) reads our lights.
 //
 //   node tests/engines/babylon_check.mjs --gltf OUT.gltf --report REPORT.json \
 //        --screenshot lit.png [--dark-gltf IN.gltf --dark-screenshot dark.png] \

@@ -1,4 +1,4 @@
-// Smoke test of the three.js example (issue 6 item 2):
+// Smoke test of the three.js example:
 //
 //   node tests/engines/threejs_check.mjs --gltf OUT.gltf --report REPORT.json --screenshot shot.png
 //
