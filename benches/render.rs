@@ -1,4 +1,4 @@
-//! Benchmark: render the Table 1 sample at 600 x 600, 64 spp (the foundation issue's target:
+//! Benchmark: render the Table 1 sample at 600 x 600, 64 spp (the target:
 //! at least 4 M reflected rays per second on 2 cores). Run with `cargo bench --bench render`.
 
 use std::time::Instant;

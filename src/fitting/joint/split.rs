@@ -1,6 +1,6 @@
 //! Overlapping streaks, method §5 and the paper's §5.3: whether one light is better
-//! explained as two, and which way to cut it (see [`super::optimise`](mod@super::optimise)). Where the two lights
-//! meet is [`super::boundary`]'s work.
+//! explained as two, and which way to cut it (see [`super::optimise`](mod@super::optimise)).
+//! Where the two lights meet is [`super::boundary`]'s work.
 
 use super::problem::{Problem, State};
 use crate::fitting::rect::Rect;

@@ -79,9 +79,11 @@ pub(super) fn uncertainties(
     // derivatives as curvature (E[J_est J_est^T] = J J^T + their variance), so along a
     // direction the photo barely constrains (Table 3's light1: its height against its
     // radiance) it claims several times the real curvature and the sigmas come out small
-    // (docs/decisions.md, "Uncertainties: the curvature of the noise-corrected cost"). The noise is far from uniform (a streak's bright pixels carry most
-    // of it, the dark surroundings none), the three channels of a pixel share it (a white
-    // light), and the stored samples add their own: a single variance sigma^2 for all would
+    // (docs/decisions.md, "Uncertainties: the curvature of the noise-corrected
+    // cost"). The
+    // noise is far from uniform (a streak's bright pixels carry most of it, the dark
+    // surroundings none), the three channels of a pixel share it (a white light), and the
+    // stored samples add their own: a single variance sigma^2 for all would
     // understate the errors tenfold (measured on Table 1), the residuals themselves carry
     // all three.
     let mut jtj = vec![0.0; p * p];
