@@ -18,7 +18,7 @@ pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
 pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
 
 use crate::fitting::gloss::estimate_gloss;
-use crate::fitting::joint::{self, fit_joint, JointOptions, Uncertainty};
+use crate::fitting::joint::{fit_joint, JointOptions, Uncertainty};
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -297,15 +297,7 @@ impl Run<'_> {
                 .iter()
                 .map(|(stage, s)| (format!("{label} {stage}"), *s)),
         );
-        found.lights = outcome
-            .lights
-            .iter()
-            .zip(&outcome.uncertainty)
-            .map(|(l, u)| FittedLight {
-                edges: joint::edge_statuses(l, u),
-                ..l.clone()
-            })
-            .collect();
+        found.lights = outcome.lights_with_statuses();
         found.uncertainties = outcome.uncertainty;
         Ok(())
     }

@@ -84,7 +84,7 @@ mod search;
 
 use std::time::Instant;
 
-use super::joint::{self, fit_joint, JointOptions, Uncertainty};
+use super::joint::{fit_joint, JointOptions, Uncertainty};
 use super::{fit_paper, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -357,15 +357,7 @@ pub fn estimate_gloss(
         },
     )?;
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
-    let lights = final_fit
-        .lights
-        .iter()
-        .zip(&final_fit.uncertainty)
-        .map(|(l, u)| FittedLight {
-            edges: joint::edge_statuses(l, u),
-            ..l.clone()
-        })
-        .collect();
+    let lights = final_fit.lights_with_statuses();
     Ok(GlossEstimate {
         gloss,
         sigma_ln: found.sigma_ln.map(|s| s as f32),

@@ -189,6 +189,21 @@ pub struct JointOutcome {
     pub timings: Vec<(String, f64)>,
 }
 
+impl JointOutcome {
+    /// The refined lights, each edge's status taken from its uncertainty ([`edge_statuses`]:
+    /// an edge the photo does not constrain is marked so).
+    pub fn lights_with_statuses(&self) -> Vec<FittedLight> {
+        self.lights
+            .iter()
+            .zip(&self.uncertainty)
+            .map(|(l, u)| FittedLight {
+                edges: edge_statuses(l, u),
+                ..l.clone()
+            })
+            .collect()
+    }
+}
+
 /// Refines `start` (typically the paper's per-streak estimate) by fitting all lights together
 /// to every water pixel of their streaks and surroundings (see the module doc).
 ///
