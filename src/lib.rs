@@ -58,6 +58,7 @@ pub mod output_file;
 pub mod photo_in;
 pub mod photo_out;
 pub mod pipeline;
+pub mod plane;
 pub mod progress;
 pub mod random;
 pub mod render;

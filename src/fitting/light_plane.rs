@@ -3,8 +3,8 @@
 
 use glam::{Vec2, Vec3};
 
-use super::plane::Plane;
 use crate::optics::ReflectionModel;
+use crate::plane::Plane;
 use crate::random::Rng;
 use crate::render::{trace, SceneHit};
 use crate::scene_in::Scene;

@@ -24,7 +24,6 @@ pub mod joint;
 pub mod light_plane;
 mod linalg;
 pub mod observation;
-pub mod plane;
 pub mod radiance;
 pub mod rect;
 mod single;

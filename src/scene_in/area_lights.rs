@@ -8,7 +8,7 @@ use glam::{DVec3, Vec3};
 use serde_json::Value;
 
 use super::nodes::NodeInstance;
-use crate::fitting::plane::Plane;
+use crate::plane::Plane;
 
 /// The draft's default intensity, used when a light omits it.
 const DEFAULT_INTENSITY: f64 = 1000.0;

@@ -1,5 +1,5 @@
 //! A plane seen from its front side, and where a ray meets it: the one ray/plane hit that a
-//! light's plane ([`super::LightPlane::hit`]) and the scene's area lights
+//! light's plane ([`crate::fitting::LightPlane::hit`]) and the scene's area lights
 //! ([`crate::scene_in::AreaLight::intersect`]) share.
 
 use glam::Vec3;
