@@ -46,6 +46,7 @@
 mod coefficient;
 mod frame;
 mod fresnel;
+mod gaussian_slopes;
 mod lobe;
 mod microfacet;
 mod shadowing;
@@ -53,6 +54,7 @@ mod shadowing;
 pub use coefficient::reflection_coefficient;
 pub use frame::orthonormal_basis;
 pub use fresnel::{fresnel_dielectric, fresnel_dielectric_sp};
+pub use gaussian_slopes::GaussianSlopes;
 pub use lobe::{compact_strata, LobeSample, ReflectionModel};
 pub use microfacet::{blinn_phong_d, cone_cos_theta, CONE_LOST_MASS};
-pub use shadowing::{beckmann_alpha, energy_cap, smith_g1, Shadowing};
+pub use shadowing::{beckmann_alpha, energy_cap, smith_g1, smith_g1_alpha, Shadowing};

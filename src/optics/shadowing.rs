@@ -41,6 +41,13 @@ pub fn beckmann_alpha(gloss: f32) -> f32 {
 /// `cos_v <= 0`.
 #[inline]
 pub fn smith_g1(cos_v: f32, gloss: f32) -> f32 {
+    smith_g1_alpha(cos_v, beckmann_alpha(gloss))
+}
+
+/// [`smith_g1`] for a Beckmann roughness `alpha` given directly (the statistical water
+/// model's lobe, whose roughness depends on the direction's azimuth).
+#[inline]
+pub fn smith_g1_alpha(cos_v: f32, alpha: f32) -> f32 {
     if cos_v <= 0.0 {
         return 0.0;
     }
@@ -48,7 +55,7 @@ pub fn smith_g1(cos_v: f32, gloss: f32) -> f32 {
         return 1.0;
     }
     let sin_v = (1.0 - cos_v * cos_v).sqrt();
-    let a = cos_v / (beckmann_alpha(gloss) * sin_v);
+    let a = cos_v / (alpha * sin_v);
     if a >= 1.6 {
         1.0
     } else {

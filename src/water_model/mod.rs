@@ -33,10 +33,14 @@
 //! [`crate::fitting::joint::fit_joint_with`]); the plain entry points use the exact model.
 
 pub mod exact;
+pub mod mean_surface;
+pub mod statistical;
 
 use glam::{Vec2, Vec3};
 
 pub use exact::ExactSurface;
+pub use mean_surface::{water_statistics, MeanSurface, WaterStatistics};
+pub use statistical::StatisticalSurface;
 
 use crate::optics::{LobeSample, ReflectionModel};
 use crate::render::WaterPoint;

@@ -1,0 +1,185 @@
+//! The mean water surface and the slope statistics of the scene's water, as the photo's
+//! camera sees it (method §10): where the statistical water model puts the water, and the
+//! start of its slope estimate.
+//!
+//! Water at rest is level, so the mean surface is a plane: the one whose normal is the mean
+//! of the water's shading normals and whose height is the mean height of the water along it,
+//! both over the water the camera sees (one camera ray through the centre of each cell of a
+//! grid over the image, the rays whose first hit is the water). A flat quad gives itself; a
+//! wave mesh gives its mean level, its waves averaged out at the scale of the whole view. The
+//! slopes are those of the shading normals relative to that plane, along two axes of it: the
+//! camera's viewing direction projected onto the plane ("along") and the horizontal
+//! direction across it. Counting by image cells weighs the water as the photo does (near
+//! water, which fills most of the image, counts most).
+
+use glam::{DVec3, Vec3};
+
+use crate::render::{camera_hit, CameraHit};
+use crate::scene_in::Scene;
+
+/// A plane of the scene frame with a tangent frame on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeanSurface {
+    /// A point of the plane.
+    pub point: Vec3,
+    /// Its unit normal, on the camera's side.
+    pub normal: Vec3,
+    /// The unit tangent "along": the camera's viewing direction projected onto the plane.
+    pub along: Vec3,
+}
+
+impl MeanSurface {
+    /// The unit tangent "across": `normal x along`.
+    pub fn across(&self) -> Vec3 {
+        self.normal.cross(self.along)
+    }
+
+    /// A plane through `point` with unit `normal` (turned to the camera at the scene
+    /// frame's origin), its "along" axis taken from the camera's `forward` (or, when the
+    /// camera looks straight down on it, from its `up`).
+    pub fn new(point: Vec3, normal: Vec3, forward: Vec3, up: Vec3) -> Self {
+        let mut normal = normal.normalize_or_zero();
+        if normal.dot(-point) < 0.0 {
+            normal = -normal;
+        }
+        let project = |d: Vec3| (d - normal * normal.dot(d)).normalize_or_zero();
+        let mut along = project(forward);
+        if along.length_squared() < 0.5 || forward.dot(normal).abs() > 0.999 {
+            along = project(up);
+        }
+        MeanSurface {
+            point,
+            normal,
+            along,
+        }
+    }
+
+    /// Where the ray `origin + t dir` (t > 0) meets the plane, and its `t`.
+    pub fn hit(&self, origin: Vec3, dir: Vec3) -> Option<(Vec3, f32)> {
+        let denom = dir.dot(self.normal);
+        if denom.abs() < 1e-12 {
+            return None;
+        }
+        let t = (self.point - origin).dot(self.normal) / denom;
+        (t > 0.0 && t.is_finite()).then(|| (origin + dir * t, t))
+    }
+
+    /// The slopes of a surface of unit normal `n` relative to this plane, along and across
+    /// (rise over run: a normal tilted towards +along has a negative slope along).
+    pub fn slopes(&self, n: Vec3) -> [f32; 2] {
+        let c = n.dot(self.normal);
+        if c <= 1e-6 {
+            return [0.0, 0.0];
+        }
+        [-n.dot(self.along) / c, -n.dot(self.across()) / c]
+    }
+}
+
+/// What the camera sees of the scene's water: its mean surface and the variances of its
+/// slopes relative to it, along and across ([`MeanSurface`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaterStatistics {
+    /// The mean surface.
+    pub surface: MeanSurface,
+    /// Variances of the slopes along and across the mean surface (dimensionless).
+    pub slope_variance: [f32; 2],
+    /// Camera rays that met the water (of a grid of `GRID` x `GRID`).
+    pub rays: usize,
+}
+
+/// Cells per side of the image grid the statistics are taken over.
+pub const GRID: u32 = 256;
+
+/// The statistics of the water the camera sees, over a `GRID` x `GRID` grid of camera rays
+/// of a `width` x `height` image (see the module doc); `None` when no ray meets the water.
+pub fn water_statistics(scene: &Scene, width: u32, height: u32) -> Option<WaterStatistics> {
+    let mut points = Vec::new();
+    let mut normals = Vec::new();
+    for j in 0..GRID {
+        for i in 0..GRID {
+            let x = (i as f32 + 0.5) / GRID as f32 * width as f32;
+            let y = (j as f32 + 0.5) / GRID as f32 * height as f32;
+            if let CameraHit::Water(w) = camera_hit(scene, &[], x, y, width, height) {
+                points.push(w.start.as_dvec3());
+                let n = if w.normal.dot(w.face) < 0.0 {
+                    -w.normal
+                } else {
+                    w.normal
+                };
+                normals.push(n.as_dvec3());
+            }
+        }
+    }
+    if points.is_empty() {
+        return None;
+    }
+    let count = points.len() as f64;
+    let normal = (normals.iter().sum::<DVec3>() / count).normalize_or_zero();
+    if normal == DVec3::ZERO {
+        return None;
+    }
+    let centroid = points.iter().sum::<DVec3>() / count;
+    // The plane through the centroid is the one of mean height along `normal`.
+    let surface = MeanSurface::new(
+        centroid.as_vec3(),
+        normal.as_vec3(),
+        scene.camera.forward,
+        scene.camera.up,
+    );
+    let slopes: Vec<[f64; 2]> = normals
+        .iter()
+        .map(|n| surface.slopes(n.as_vec3()).map(|s| s as f64))
+        .collect();
+    let mean = [0, 1].map(|a| slopes.iter().map(|s| s[a]).sum::<f64>() / count);
+    let variance = [0, 1]
+        .map(|a| (slopes.iter().map(|s| (s[a] - mean[a]).powi(2)).sum::<f64>() / count) as f32);
+    Some(WaterStatistics {
+        surface,
+        slope_variance: variance,
+        rays: points.len(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slopes_are_rise_over_run_in_the_plane_frame() {
+        let s = MeanSurface::new(
+            Vec3::new(0.0, -1.0, 0.0),
+            Vec3::Y,
+            Vec3::new(0.0, -0.2, -1.0).normalize(),
+            Vec3::Y,
+        );
+        assert!((s.along - Vec3::NEG_Z).length() < 1e-6);
+        assert!(
+            (s.across() - Vec3::new(-1.0, 0.0, 0.0)).length() < 1e-6,
+            "{:?}",
+            s.across()
+        );
+        // The surface y = 0.1 * (-z) rises away from the camera: its normal is
+        // (0, 1, 0.1) normalised, and its slope along -z is +0.1.
+        let n = Vec3::new(0.0, 1.0, 0.1).normalize();
+        let [a, c] = s.slopes(n);
+        assert!((a - 0.1).abs() < 1e-6 && c.abs() < 1e-6, "{a} {c}");
+        // A normal below the camera's side is turned up by `new`.
+        let down = MeanSurface::new(Vec3::new(0.0, -1.0, 0.0), Vec3::NEG_Y, Vec3::NEG_Z, Vec3::Y);
+        assert_eq!(down.normal, Vec3::Y);
+    }
+
+    #[test]
+    fn a_camera_looking_straight_down_takes_along_from_its_up() {
+        let s = MeanSurface::new(Vec3::new(0.0, -2.0, 0.0), Vec3::Y, Vec3::NEG_Y, Vec3::NEG_Z);
+        assert!((s.along - Vec3::NEG_Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn hits_in_front_only() {
+        let s = MeanSurface::new(Vec3::new(0.0, -1.0, 0.0), Vec3::Y, Vec3::NEG_Z, Vec3::Y);
+        let (p, t) = s.hit(Vec3::ZERO, Vec3::new(0.0, -1.0, -1.0)).unwrap();
+        assert!((p - Vec3::new(0.0, -1.0, -1.0)).length() < 1e-6 && (t - 1.0).abs() < 1e-6);
+        assert!(s.hit(Vec3::ZERO, Vec3::new(0.0, 1.0, -1.0)).is_none());
+        assert!(s.hit(Vec3::ZERO, Vec3::NEG_Z).is_none());
+    }
+}
