@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use streaklight::convert::{convert, ConvertOptions};
-use streaklight::pipeline::{FitSettings, JointSettings, Method};
+use streaklight::pipeline::{FitSettings, JointSettings, Method, WaterChoice};
 use streaklight::progress::Reporter;
 
 use super::scene_args::SceneArgs;
@@ -49,6 +49,14 @@ pub struct Args {
     /// estimate alone, corrected; faster, for comparison).
     #[arg(long, default_value = "joint", value_parser = ["joint", "paper"])]
     pub method: String,
+    /// Which model of the water to fit with: "exact" (the scene's water mesh holds the
+    /// photo's very waves, as when the photo was rendered from the scene), "statistical" (the
+    /// scene gives the mean water surface, a flat quad or another field of waves, and the
+    /// waves' slopes are estimated from the photo, along and across the view), or "auto"
+    /// (exact if its fine structure matches the photo's, else statistical; the report says
+    /// which, and why).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "exact", "statistical"])]
+    pub water_model: String,
     /// Run the joint fit this many times, each from its own samples, and report the mean: N
     /// times slower, about sqrt(N) times less of the samples' noise; the uncertainties add the
     /// fits' spread (and so come out on the wide side).
@@ -107,6 +115,11 @@ impl Args {
             shadowing: self.scene_options.shadowing(),
             streaks: self.streak.params()?,
             method,
+            water: match self.water_model.as_str() {
+                "exact" => WaterChoice::Exact,
+                "statistical" => WaterChoice::Statistical,
+                _ => WaterChoice::Auto,
+            },
         })
     }
 }

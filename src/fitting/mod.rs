@@ -27,6 +27,7 @@ pub mod observation;
 pub mod radiance;
 pub mod rect;
 mod single;
+pub mod slopes;
 pub mod threshold;
 
 use std::time::Instant;

@@ -11,14 +11,19 @@
 mod photo_check;
 mod settings;
 mod warnings;
+mod water_choice;
+mod water_fit;
 
 use std::time::Instant;
 
 pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
 pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
+pub use water_choice::{
+    fine_structure_correlation, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_CORRELATION,
+};
 
 use crate::fitting::gloss::estimate_gloss;
-use crate::fitting::joint::{fit_joint, JointOptions, Uncertainty};
+use crate::fitting::joint::{fit_joint_with, JointOptions, Uncertainty};
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -26,6 +31,7 @@ use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::settings::Setting;
 use crate::streaks::{self, Segmentation};
+use crate::water_model::{ExactSurface, WaterModel};
 use crate::{water_mask, Error, Result};
 
 /// What a fit found.
@@ -48,6 +54,8 @@ pub struct Lit {
     pub gloss_source: String,
     /// What the final joint fit read (`None` for the paper's method).
     pub reading: Option<Reading>,
+    /// The water model the lights were fitted with, and why.
+    pub water_model: WaterModelUsed,
     /// The photo's water mask (method §5 step 2).
     pub water: Vec<bool>,
     /// The streak extraction, every stage of it.
@@ -178,22 +186,16 @@ pub fn fit(
             Method::Joint(j) => Some(j.reading),
         },
         timings: Vec::new(),
+        modelled: Vec::new(),
     };
-    if !observations.is_empty() {
-        match &settings.method {
-            Method::Joint(j) if matches!(j.gloss, GlossFit::Estimate(_)) => {
-                run.with_gloss_search(j, &mut found)?
-            }
-            method => {
-                run.paper(&mut found)?;
-                if let Method::Joint(j) = method {
-                    if !found.lights.is_empty() {
-                        run.refine(j, &mut found)?;
-                    }
-                }
-            }
-        }
-    }
+    let water_model = if observations.is_empty() {
+        WaterModelUsed::forced(match settings.water {
+            WaterChoice::Statistical => "statistical",
+            WaterChoice::Exact | WaterChoice::Auto => "exact",
+        })
+    } else {
+        run.fit_lights(settings, &mut found)?
+    };
     clock.add_fit(&found.timings);
     let nothing_found = found
         .lights
@@ -213,6 +215,7 @@ pub fn fit(
         gloss: found.gloss.0,
         gloss_source: found.gloss.1,
         reading: found.reading,
+        water_model,
         water,
         segmentation,
         nothing_found,
@@ -229,6 +232,8 @@ struct Found {
     gloss: (f32, String),
     reading: Option<Reading>,
     timings: Vec<(String, f64)>,
+    /// The last joint fit's expected image (its fitted pixels and their modelled radiance).
+    modelled: Vec<(u32, [f32; 3])>,
 }
 
 /// The inputs every fitting stage of one run shares.
@@ -278,12 +283,14 @@ impl Run<'_> {
     /// light's edge statuses from its uncertainty.
     fn joint(
         &self,
+        water_model: &dyn WaterModel,
         start: &[FittedLight],
         options: &JointOptions,
         label: &str,
         found: &mut Found,
     ) -> Result<()> {
-        let outcome = fit_joint(
+        let outcome = fit_joint_with(
+            water_model,
             self.scene,
             self.photo,
             self.water,
@@ -299,6 +306,7 @@ impl Run<'_> {
         );
         found.lights = outcome.lights_with_statuses();
         found.uncertainties = outcome.uncertainty;
+        found.modelled = outcome.modelled;
         Ok(())
     }
 
@@ -309,14 +317,15 @@ impl Run<'_> {
             .stage(&format!("joint fit of {} light(s)", found.lights.len()));
         let start = std::mem::take(&mut found.lights);
         let options = self.joint_options(j, j.reading);
-        self.joint(&start, &options, "joint", found)?;
-        self.refit_overlaps(&start, &options, j, found)
+        self.joint(&ExactSurface, &start, &options, "joint", found)?;
+        self.refit_overlaps(&ExactSurface, &start, &options, j, found)
     }
 
     /// Fits the lights again from `start` with [`JointSettings::overlap_refit`] when the fit
     /// in `found` ended with lights that share a streak.
     fn refit_overlaps(
         &self,
+        water_model: &dyn WaterModel,
         start: &[FittedLight],
         options: &JointOptions,
         j: &JointSettings,
@@ -343,7 +352,7 @@ impl Run<'_> {
             ..*options
         };
         found.reading = Some(reading);
-        self.joint(start, &refit, "joint refit of overlaps", found)
+        self.joint(water_model, start, &refit, "joint refit of overlaps", found)
     }
 
     /// The joint fit with the gloss estimated first ([`GlossFit::Estimate`]).
@@ -386,6 +395,6 @@ impl Run<'_> {
             },
             ..final_fit
         };
-        self.refit_overlaps(&estimate.start, &at_estimate, j, found)
+        self.refit_overlaps(&ExactSurface, &estimate.start, &at_estimate, j, found)
     }
 }

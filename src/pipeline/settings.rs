@@ -2,6 +2,7 @@
 //! method carries its own settings (the paper's estimate has no joint-fit settings; estimating
 //! the gloss is part of the joint fit's), and each value is held in one place.
 
+use super::water_choice::WaterChoice;
 use crate::fitting::gloss::{GlossSearch, SEARCH_SAMPLES};
 use crate::fitting::joint::DEFAULT_JOINT_SAMPLES;
 use crate::fitting::DEFAULT_SAMPLES;
@@ -24,11 +25,14 @@ pub struct FitSettings {
     pub streaks: StreakParams,
     /// How the lights are fitted.
     pub method: Method,
+    /// Which model of the water the fit inverts (method §10).
+    pub water: WaterChoice,
 }
 
 impl Default for FitSettings {
     /// The defaults of `streaklight fit`: [`DEFAULT_SAMPLES`] samples, seed 1, the paper's
-    /// G = 1, the default streak extraction, the joint method with the scene's gloss.
+    /// G = 1, the default streak extraction, the joint method with the scene's gloss, the
+    /// water model chosen from the photo.
     fn default() -> Self {
         FitSettings {
             samples: DEFAULT_SAMPLES,
@@ -36,6 +40,7 @@ impl Default for FitSettings {
             shadowing: Shadowing::None,
             streaks: StreakParams::default(),
             method: Method::default(),
+            water: WaterChoice::default(),
         }
     }
 }

@@ -68,6 +68,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             camera: scene.camera.name.clone(),
             water: scene.water.name.clone(),
         },
+        water_model: lit.water_model.clone(),
         lights: lit
             .lights
             .iter()

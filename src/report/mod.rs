@@ -19,6 +19,8 @@ pub struct Report {
     pub files: Files,
     /// The model and sampling settings used.
     pub settings: Settings,
+    /// The water model the lights were fitted with, why, and its slope estimate.
+    pub water_model: crate::pipeline::WaterModelUsed,
     /// One entry per light written.
     pub lights: Vec<LightReport>,
     /// Streaks that gave no light, and why.

@@ -26,6 +26,10 @@ pub struct MeanSurface {
     pub normal: Vec3,
     /// The unit tangent "along": the camera's viewing direction projected onto the plane.
     pub along: Vec3,
+    /// How far the scene's water rises above the plane at most (0 for a flat quad): the
+    /// statistical model's reflected rays leave from this high, so that they clear the
+    /// scene's own crests, which the model replaces by its masking term.
+    pub crest: f32,
 }
 
 impl MeanSurface {
@@ -51,6 +55,7 @@ impl MeanSurface {
             point,
             normal,
             along,
+            crest: 0.0,
         }
     }
 
@@ -120,12 +125,20 @@ pub fn water_statistics(scene: &Scene, width: u32, height: u32) -> Option<WaterS
     }
     let centroid = points.iter().sum::<DVec3>() / count;
     // The plane through the centroid is the one of mean height along `normal`.
-    let surface = MeanSurface::new(
+    let mut surface = MeanSurface::new(
         centroid.as_vec3(),
         normal.as_vec3(),
         scene.camera.forward,
         scene.camera.up,
     );
+    surface.crest = scene
+        .triangles
+        .iter()
+        .zip(&scene.is_water)
+        .filter(|(_, &w)| w)
+        .flat_map(|(t, _)| t.iter())
+        .map(|&p| (p - surface.point).dot(surface.normal))
+        .fold(0.0f32, f32::max);
     let slopes: Vec<[f64; 2]> = normals
         .iter()
         .map(|n| surface.slopes(n.as_vec3()).map(|s| s as f64))

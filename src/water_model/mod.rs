@@ -56,8 +56,9 @@ use crate::scene_in::Scene;
 /// An implementation must be deterministic (the same arguments give the same answer: the
 /// fits' reproducibility and their common random numbers across parameter values rest on it)
 /// and draws no random number of its own; one that samples its surface derives what it needs
-/// from its arguments. It is shared by the fitters' threads (`Sync`).
-pub trait WaterModel: Sync {
+/// from its arguments. It is shared by the fitters' threads (`Sync`), and shows itself in the
+/// fits' options (`Debug`).
+pub trait WaterModel: Sync + std::fmt::Debug {
     /// Where the camera ray through image position (`x`, `y`) of a `width` x `height` image
     /// meets the water, or `None` when it sees anything else first (or nothing): such a
     /// camera ray counts in the pixel's mean with weight 0.

@@ -15,6 +15,10 @@
 //! average over tilted facets down to 4 degrees above the water, where without it the
 //! facets turned towards the camera count 3 % too much (the tests below).
 //!
+//! The reflected rays leave from the mean plane lifted to the scene's highest crest
+//! ([`MeanSurface::crest`]): the scene's own waves must not shadow them a second time, and the
+//! lift (millimetres to centimetres) moves nothing a light's plane metres away can show.
+//!
 //! Which pixels see water is still the scene's business: a camera ray counts when its first
 //! hit is a water triangle (so the quay, boats and the far shore hide the water as they do in
 //! the exact model), and then meets the mean plane instead of the triangle.
@@ -68,7 +72,7 @@ impl WaterModel for StatisticalSurface {
         let (p, _) = self.surface.hit(origin, dir)?;
         let n = self.surface.normal;
         Some(WaterPoint {
-            start: p + n * surface_offset(p),
+            start: p + n * (self.surface.crest + surface_offset(p)),
             wo: -dir,
             normal: n,
             face: n,

@@ -14,7 +14,7 @@ use crate::render::WaterPoint;
 use crate::scene_in::Scene;
 
 /// The exact model behind another type, counting the questions it is asked.
-#[derive(Default)]
+#[derive(Debug, Default)]
 struct Delegating {
     water_points: AtomicUsize,
     reflections: AtomicUsize,

@@ -80,7 +80,7 @@
 //! gap between the lights. `table3.png` (two lights side by side, one reaching out of the
 //! photo) gives 502.
 
-mod search;
+pub(super) mod search;
 
 use std::time::Instant;
 
@@ -267,37 +267,8 @@ pub fn estimate_gloss(
     };
     let paper = fit_paper(scene, photo, water, streaks, &start_options)?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
-    if paper.lights.is_empty() {
-        return Err(Error::NothingFound(format!(
-            "{} streak(s) found but no light could be fitted, so the gloss cannot be \
-             estimated: {}",
-            streaks.len(),
-            paper
-                .skipped
-                .iter()
-                .map(skipped_message)
-                .collect::<Vec<_>>()
-                .join("; ")
-        )));
-    }
+    let start = search_start(&paper, streaks.len(), "gloss")?;
     let mut warnings = paper.warnings.clone();
-    // The paper fit under the start gloss places an edge it found no pixel for at the lobes'
-    // farthest reach, and the joint fit would hold it there; under another gloss that reach
-    // is another, so the search lets every edge move.
-    let start: Vec<FittedLight> = paper
-        .lights
-        .iter()
-        .map(|l| FittedLight {
-            edges: l.edges.clone().map(|e| match e {
-                EdgeStatus::Unconstrained { reason, .. } => EdgeStatus::Unconstrained {
-                    reason,
-                    unseen: false,
-                },
-                constrained => constrained,
-            }),
-            ..l.clone()
-        })
-        .collect();
 
     let t = Instant::now();
     let mut cost = Cost {
@@ -311,7 +282,13 @@ pub fn estimate_gloss(
         evaluations: Vec::new(),
         failed: Vec::new(),
     };
-    let found = search(options, x0, lo, hi, |x| cost.point(x))?;
+    let found = search(
+        options,
+        x0,
+        (lo, hi),
+        ("gloss", &|e| format!("{e:.0}")),
+        |x| cost.point(x),
+    )?;
     timings.push((
         format!("search ({} evaluations)", cost.evaluations.len()),
         t.elapsed().as_secs_f64(),
@@ -374,6 +351,44 @@ pub fn estimate_gloss(
         warnings,
         timings,
     })
+}
+
+/// The start of a search over the water's lobe from the paper fit `paper` of `streaks`
+/// streaks: its lights with every edge free to move (the paper fit places an edge it found
+/// no pixel for at the lobes' farthest reach, and the joint fit would hold it there; under
+/// another lobe that reach is another). Fails when the paper fit found no light (`what` is
+/// the parameter that then cannot be estimated).
+pub(super) fn search_start(
+    paper: &super::FitOutcome,
+    streaks: usize,
+    what: &str,
+) -> Result<Vec<FittedLight>> {
+    if paper.lights.is_empty() {
+        return Err(Error::NothingFound(format!(
+            "{streaks} streak(s) found but no light could be fitted, so the {what} cannot be \
+             estimated: {}",
+            paper
+                .skipped
+                .iter()
+                .map(skipped_message)
+                .collect::<Vec<_>>()
+                .join("; ")
+        )));
+    }
+    Ok(paper
+        .lights
+        .iter()
+        .map(|l| FittedLight {
+            edges: l.edges.clone().map(|e| match e {
+                EdgeStatus::Unconstrained { reason, .. } => EdgeStatus::Unconstrained {
+                    reason,
+                    unseen: false,
+                },
+                constrained => constrained,
+            }),
+            ..l.clone()
+        })
+        .collect())
 }
 
 fn skipped_message(s: &Skipped) -> String {

@@ -6,33 +6,36 @@ use crate::{Error, Result};
 
 /// A point of the cost curve: `x = ln e`, its cost and residual variance.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Point {
-    pub(super) x: f64,
-    pub(super) s: f64,
-    pub(super) variance: f64,
+pub(in crate::fitting) struct Point {
+    pub(in crate::fitting) x: f64,
+    pub(in crate::fitting) s: f64,
+    pub(in crate::fitting) variance: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Stop {
+pub(in crate::fitting) enum Stop {
     Converged,
     AtLimit,
     OutOfEvaluations,
 }
 
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Found {
-    pub(super) x: f64,
-    pub(super) sigma_ln: Option<f64>,
-    pub(super) stop: Stop,
+pub(in crate::fitting) struct Found {
+    pub(in crate::fitting) x: f64,
+    pub(in crate::fitting) sigma_ln: Option<f64>,
+    pub(in crate::fitting) stop: Stop,
 }
 
 /// Minimises `cost` over `x = ln e` in [lo, hi] from `x0` (module doc, "Search"); `cost`
-/// gives the point at x (an infinite cost: no evidence there).
-pub(super) fn search(
+/// gives the point at x (an infinite cost: no evidence there). The same search serves any
+/// parameter that acts multiplicatively (the waves' slope variances, [`crate::fitting::slopes`]):
+/// `name` says what `x` is the logarithm of, `show` prints `exp(x)`, in the error when every
+/// fit broke down.
+pub(in crate::fitting) fn search(
     opts: &GlossSearch,
     x0: f64,
-    lo: f64,
-    hi: f64,
+    (lo, hi): (f64, f64),
+    (name, show): (&str, &dyn Fn(f64) -> String),
     mut cost: impl FnMut(f64) -> Result<Point>,
 ) -> Result<Found> {
     let h = opts.first_step_ln as f64;
@@ -54,10 +57,10 @@ pub(super) fn search(
         let best = pts[ib];
         if !best.s.is_finite() {
             return Err(Error::NothingFound(format!(
-                "the joint fit broke down at every gloss tried ({}): the gloss cannot be \
+                "the joint fit broke down at every {name} tried ({}): the {name} cannot be \
                  estimated from this photo",
                 pts.iter()
-                    .map(|p| format!("{:.0}", p.x.exp()))
+                    .map(|p| show(p.x.exp()))
                     .collect::<Vec<_>>()
                     .join(", ")
             )));
@@ -184,6 +187,8 @@ mod tests {
     }
 
     /// The search's default options.
+    const GLOSS: (&str, &dyn Fn(f64) -> String) = ("gloss", &|e| format!("{e:.0}"));
+
     fn options() -> GlossSearch {
         GlossSearch::default()
     }
@@ -192,7 +197,7 @@ mod tests {
     /// points it evaluated.
     fn run(opts: &GlossSearch, f: impl Fn(f64) -> f64) -> (Found, Vec<f64>) {
         let mut xs = Vec::new();
-        let found = search(opts, 500f64.ln(), 50f64.ln(), 5000f64.ln(), |x| {
+        let found = search(opts, 500f64.ln(), (50f64.ln(), 5000f64.ln()), GLOSS, |x| {
             xs.push(x);
             Ok(pt(x, f(x)))
         })
@@ -253,7 +258,9 @@ mod tests {
         let (found, _) = run(&options(), f);
         assert!((found.x.exp() / 160.0 - 1.0).abs() < 0.05, "{found:?}");
         // And nothing but broken fits is an error, not a guess.
-        let all_broken = search(&options(), 6.0, 4.0, 8.0, |x| Ok(pt(x, f64::INFINITY)));
+        let all_broken = search(&options(), 6.0, (4.0, 8.0), GLOSS, |x| {
+            Ok(pt(x, f64::INFINITY))
+        });
         assert!(matches!(all_broken, Err(Error::NothingFound(_))));
     }
 

@@ -136,6 +136,10 @@ pub struct JointOptions<'a> {
     /// model's). Fits under different glosses are comparable only over the same pixels, so a
     /// gloss search fixes it to the broadest lobe it will try.
     pub region_gloss: Option<f32>,
+    /// The water model whose lobes (at the region gloss) decide which pixels are fitted
+    /// (`None`: the fit's own). A search over the statistical model's slopes fixes it to the
+    /// broadest lobe it will try, as a gloss search fixes [`region_gloss`](Self::region_gloss).
+    pub region_water: Option<&'a dyn WaterModel>,
     /// Independent fits, each from its own samples, whose mean is the result (at least 1).
     /// From 2 on, their spread is added to the uncertainties (how far the samples move the
     /// fit); the mean's own error falls as one over the square root of
@@ -160,6 +164,7 @@ impl JointOptions<'_> {
             checkerboard: true,
             split: true,
             region_gloss: None,
+            region_water: None,
             repeats: 1,
             progress: Reporter::default(),
             control_variate: true,
@@ -187,6 +192,9 @@ pub struct JointOutcome {
     pub cost: f64,
     /// Wall-clock seconds: "footprints" and "optimise".
     pub timings: Vec<(String, f64)>,
+    /// The fitted pixels (index `y * width + x` into the photo) with their modelled radiance
+    /// at the optimum, per channel: the expected image the photo was compared with.
+    pub modelled: Vec<(u32, [f32; 3])>,
 }
 
 impl JointOutcome {
@@ -254,6 +262,7 @@ pub fn fit_joint_with(
             residual_variance: 0.0,
             cost: 0.0,
             timings: Vec::new(),
+            modelled: Vec::new(),
         });
     }
     let used: Vec<&StreakObservation> = streaks
@@ -280,7 +289,7 @@ pub fn fit_joint_with(
         ..options.model
     };
     let pixels = region(
-        water_model,
+        options.region_water.unwrap_or(water_model),
         scene,
         &probe_model,
         &planes,
@@ -398,6 +407,14 @@ pub fn fit_joint_with(
         u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
     }
     optimise_seconds += t2.elapsed().as_secs_f64();
+    let modelled = (0..problem.n())
+        .map(|i| {
+            (
+                problem.pixel_ids[i],
+                problem.model(&st, i).map(|c| c as f32),
+            )
+        })
+        .collect();
     let facing = facing_edges(&problem, &st);
     let lights = (0..st.rects.len())
         .map(|k| {
@@ -434,5 +451,6 @@ pub fn fit_joint_with(
             ("footprints".into(), footprint_seconds),
             ("optimise".into(), optimise_seconds),
         ],
+        modelled,
     })
 }

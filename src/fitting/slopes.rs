@@ -1,0 +1,274 @@
+//! Estimating the waves' slope variances from the photo together with the lights, for the
+//! statistical water model (method §10).
+//!
+//! Under the statistical model the lobe is set by two slope variances, along the camera's
+//! view on the water and across it ([`StatisticalSurface`]): the streak's length follows the
+//! first, its width the second. They are measured as the gloss is (the gloss module's doc):
+//! the variances whose best lights explain the photo best,
+//!
+//! ```text
+//! (v_a, v_c) = argmin min_{lights} S(v_a, v_c, lights)
+//! ```
+//!
+//! with `S` the joint fit's noise-debiased residual sum of squares, by the same
+//! one-dimensional search over the logarithm, one axis at a time: along, then across, then
+//! along again when across moved (the two interact through the rectangle's corners only).
+//! Every fit starts from the same lights (the paper fit at the starting variances), reads the
+//! same pixels (those the broadest lobe of the search can see: four times the starting
+//! variances) with the same random numbers, so the costs are comparable.
+//!
+//! The variances are the lobe's whole: the water's microfacets are given a gloss of
+//! [`MICROFACET_GLOSS`], finer than any wave, and the waves' variances carry the rest. So the
+//! search starts from any estimate of the whole, the material's roughness of a flat quad or a
+//! wave mesh's measured slopes plus its material's, and can move either way from it.
+//!
+//! Uncertainty: each axis's from the curvature of its last search (the gloss module's doc,
+//! "Uncertainty"), a lower bound that leaves out the axes' correlation.
+
+use std::time::Instant;
+
+use super::gloss::search::{search, Point, Stop};
+use super::gloss::{search_start, GlossSearch};
+use super::joint::{fit_joint_with, JointOptions, Uncertainty};
+use super::{fit_paper_with, FitOptions, FittedLight, Skipped, StreakObservation};
+use crate::optics::{GaussianSlopes, ReflectionModel};
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+use crate::water_model::{MeanSurface, StatisticalSurface};
+use crate::Result;
+
+/// The gloss of the water's microfacets under the statistical model: slope variance
+/// `1 / (e + 2)` = 5e-5, below any the photos show, so the waves' variances hold the lobe.
+pub const MICROFACET_GLOSS: f32 = 20000.0;
+
+/// The smallest and largest total slope variance searched.
+pub const VARIANCE_RANGE: (f32, f32) = (1e-4, 0.05);
+
+/// The total slope variances (microfacets and waves) of the lobe of gloss `gloss` under waves
+/// of variances `waves`.
+pub fn total_variance(gloss: f32, waves: [f32; 2]) -> [f32; 2] {
+    GaussianSlopes::microfacets_and_waves(gloss, waves).variance
+}
+
+/// The statistical water over `surface` whose lobe has total slope variances `total` (with
+/// [`MICROFACET_GLOSS`] microfacets).
+pub fn water_with_total(surface: MeanSurface, total: [f32; 2]) -> StatisticalSurface {
+    let micro = GaussianSlopes::from_gloss(MICROFACET_GLOSS).variance[0];
+    StatisticalSurface {
+        surface,
+        waves: total.map(|v| (v - micro).max(0.0)),
+    }
+}
+
+/// The estimated slope variances and the lights fitted with them.
+#[derive(Clone, Debug)]
+pub struct SlopeEstimate {
+    /// The statistical water at the estimate.
+    pub water: StatisticalSurface,
+    /// The total slope variances along and across (dimensionless).
+    pub variance: [f32; 2],
+    /// One-sigma statistical uncertainty of the natural logarithm of each (about the relative
+    /// uncertainty); `None` where the minimum was not bracketed.
+    pub sigma_ln: [Option<f32>; 2],
+    /// Where the search started.
+    pub start_variance: [f32; 2],
+    /// Every evaluation: (variances along and across, cost).
+    pub evaluations: Vec<([f32; 2], f64)>,
+    /// The lights fitted at the estimate with the final fit's options, edge statuses from
+    /// their uncertainties.
+    pub lights: Vec<FittedLight>,
+    /// Their uncertainties.
+    pub uncertainty: Vec<Uncertainty>,
+    /// The paper fit's lights at the start: every fit's start.
+    pub start: Vec<FittedLight>,
+    /// Streaks the paper fit could not turn into a light.
+    pub skipped: Vec<Skipped>,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+    /// Wall-clock seconds per stage.
+    pub timings: Vec<(String, f64)>,
+    /// The final fit's cost (comparable between fits of the same pixels).
+    pub cost: f64,
+}
+
+/// Estimates the slope variances over `surface` from the start `start_variance` (totals,
+/// along and across) and fits the lights with them (module doc). `paper` and `final_fit` as
+/// for [`super::gloss::estimate_gloss`] (their models' gloss is replaced by
+/// [`MICROFACET_GLOSS`]); `options` the one-dimensional search's settings, in the logarithm
+/// of a variance.
+#[allow(clippy::too_many_arguments)]
+pub fn estimate_slopes(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    surface: MeanSurface,
+    start_variance: [f32; 2],
+    paper: &FitOptions,
+    final_fit: &JointOptions,
+    options: &GlossSearch,
+) -> Result<SlopeEstimate> {
+    let (lo, hi) = VARIANCE_RANGE;
+    let start_variance = start_variance.map(|v| v.clamp(lo, hi));
+    let model = ReflectionModel {
+        gloss: MICROFACET_GLOSS,
+        ..paper.model
+    };
+    let mut timings = Vec::new();
+    let t = Instant::now();
+    let start_water = water_with_total(surface, start_variance);
+    let paper_fit = fit_paper_with(
+        &start_water,
+        scene,
+        photo,
+        water,
+        streaks,
+        &FitOptions { model, ..*paper },
+    )?;
+    timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
+    let start = search_start(&paper_fit, streaks.len(), "waves' slope")?;
+    let mut warnings = paper_fit.warnings.clone();
+    let broad = water_with_total(surface, start_variance.map(|v| (4.0 * v).min(hi)));
+    let search_options = JointOptions {
+        samples: options.search_samples,
+        sweeps: options.search_sweeps,
+        // A wrong lobe leaves a structured residual too: splitting there would fit the
+        // lobe's error, not a second light.
+        split: false,
+        region_water: Some(&broad),
+        progress: final_fit.progress,
+        ..JointOptions::new(model, paper.seed)
+    };
+    let mut evaluations: Vec<([f32; 2], f64)> = Vec::new();
+    let mut variance = start_variance;
+    let mut sigma_ln = [None, None];
+    let t = Instant::now();
+    let eval = |v: [f32; 2], evaluations: &mut Vec<([f32; 2], f64)>| -> Result<Point> {
+        final_fit.progress.stage(&format!(
+            "slope search: joint fit {} at variances {:.2e} along, {:.2e} across",
+            evaluations.len() + 1,
+            v[0],
+            v[1]
+        ));
+        let fit = fit_joint_with(
+            &water_with_total(surface, v),
+            scene,
+            photo,
+            water,
+            streaks,
+            &start,
+            &search_options,
+        )?;
+        let s = if fit.cost.is_finite() && fit.cost > 0.0 {
+            fit.cost
+        } else {
+            f64::INFINITY
+        };
+        evaluations.push((v, s));
+        Ok(Point {
+            x: 0.0,
+            s,
+            variance: fit.residual_variance,
+        })
+    };
+    let (lo_ln, hi_ln) = ((lo as f64).ln(), (hi as f64).ln());
+    let show: &dyn Fn(f64) -> String = &|v| format!("{v:.2e}");
+    for (pass, axis) in [0usize, 1, 0].into_iter().enumerate() {
+        if pass == 2 {
+            // Along again only when across moved enough to matter.
+            let moved = (variance[1] / start_variance[1]).ln().abs();
+            if moved < options.tolerance_ln {
+                break;
+            }
+        }
+        let name = ["slope variance along", "slope variance across"][axis];
+        let found = search(
+            options,
+            (variance[axis] as f64).ln(),
+            (lo_ln, hi_ln),
+            (name, show),
+            |x| {
+                let mut v = variance;
+                v[axis] = x.exp() as f32;
+                eval(v, &mut evaluations).map(|p| Point { x, ..p })
+            },
+        )?;
+        variance[axis] = found.x.exp() as f32;
+        sigma_ln[axis] = found.sigma_ln.map(|s| s as f32);
+        match found.stop {
+            Stop::Converged => {}
+            Stop::AtLimit => warnings.push(format!(
+                "the {name} lies at the search's limit ({:.2e}, searched {lo:.0e} to {hi:.0e})",
+                variance[axis]
+            )),
+            Stop::OutOfEvaluations => warnings.push(format!(
+                "the search of the {name} stopped after {} evaluations before converging",
+                options.max_evaluations
+            )),
+        }
+    }
+    timings.push((
+        format!("slope search ({} evaluations)", evaluations.len()),
+        t.elapsed().as_secs_f64(),
+    ));
+    let failed = evaluations.iter().filter(|e| !e.1.is_finite()).count();
+    if failed > 0 {
+        warnings.push(format!(
+            "the joint fit broke down (no positive cost) at {failed} of the slope search's \
+             evaluations; those were left out"
+        ));
+    }
+    final_fit.progress.stage(&format!(
+        "slope search: final joint fit at variances {:.2e} along, {:.2e} across",
+        variance[0], variance[1]
+    ));
+    let t = Instant::now();
+    let at = water_with_total(surface, variance);
+    let fit = fit_joint_with(
+        &at,
+        scene,
+        photo,
+        water,
+        streaks,
+        &paper_fit.lights,
+        &JointOptions {
+            model,
+            ..*final_fit
+        },
+    )?;
+    timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
+    Ok(SlopeEstimate {
+        water: at,
+        variance,
+        sigma_ln,
+        start_variance,
+        evaluations,
+        lights: fit.lights_with_statuses(),
+        uncertainty: fit.uncertainty,
+        start: paper_fit.lights,
+        skipped: paper_fit.skipped,
+        warnings,
+        timings,
+        cost: fit.cost,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn totals_and_waves_convert_both_ways() {
+        let surface = MeanSurface::new(
+            glam::Vec3::new(0.0, -1.0, -5.0),
+            glam::Vec3::Y,
+            glam::Vec3::NEG_Z,
+            glam::Vec3::Y,
+        );
+        let w = water_with_total(surface, [0.003, 0.001]);
+        let back = total_variance(MICROFACET_GLOSS, w.waves);
+        assert!((back[0] - 0.003).abs() < 1e-9 && (back[1] - 0.001).abs() < 1e-9);
+        // A total below the microfacets' own is the microfacets alone.
+        assert_eq!(water_with_total(surface, [1e-6, 1e-6]).waves, [0.0, 0.0]);
+    }
+}

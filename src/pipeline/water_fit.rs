@@ -1,0 +1,244 @@
+//! The fit under the chosen water model ([`WaterChoice`]): the exact model's steps, the
+//! statistical model's, and the automatic choice between them (the water_choice module's
+//! doc).
+
+use super::water_choice::{fine_structure_correlation, SlopesUsed, WaterChoice, WaterModelUsed};
+use super::{Found, GlossFit, JointSettings, Method, Run, EXACT_MIN_CORRELATION};
+use crate::fitting::gloss::GlossSearch;
+use crate::fitting::joint::JointOptions;
+use crate::fitting::slopes::{estimate_slopes, water_with_total, MICROFACET_GLOSS};
+use crate::fitting::{self, FitOptions};
+use crate::optics::{GaussianSlopes, ReflectionModel};
+use crate::settings::Setting;
+use crate::water_model::water_statistics;
+use crate::{Error, Result};
+
+impl WaterModelUsed {
+    /// `model` as the settings asked for it.
+    pub(super) fn forced(model: &'static str) -> Self {
+        WaterModelUsed {
+            model,
+            chosen: "forced",
+            fine_structure_correlation: None,
+            threshold: EXACT_MIN_CORRELATION,
+            slopes: None,
+        }
+    }
+}
+
+/// The one-dimensional searches of the slope variances: in the logarithm of a variance
+/// (twice that of the lobe's width), so the gloss search's steps doubled.
+fn slope_search() -> GlossSearch {
+    let gloss = GlossSearch::default();
+    GlossSearch {
+        first_step_ln: 2.0 * gloss.first_step_ln,
+        max_step_ln: 2.0 * gloss.max_step_ln,
+        tolerance_ln: 2.0 * gloss.tolerance_ln,
+        max_bracket_ln: 2.0 * gloss.max_bracket_ln,
+        max_evaluations: 10,
+        ..gloss
+    }
+}
+
+impl Run<'_> {
+    /// The lights of the streaks under the water model `settings` choose (or the one the
+    /// photo asks for), into `found`; says which model and why.
+    pub(super) fn fit_lights(
+        &self,
+        settings: &super::FitSettings,
+        found: &mut Found,
+    ) -> Result<WaterModelUsed> {
+        match (settings.water, &settings.method) {
+            (WaterChoice::Statistical, method) => self.statistical(method, found, "forced", None),
+            (WaterChoice::Exact, method) => {
+                self.exact(method, found)?;
+                Ok(WaterModelUsed::forced("exact"))
+            }
+            // The paper's per-streak estimate has no expected image to compare.
+            (WaterChoice::Auto, method @ Method::Paper) => {
+                self.exact(method, found)?;
+                Ok(WaterModelUsed {
+                    chosen: "the paper's method: the exact model unless the statistical one \
+                             is asked for",
+                    ..WaterModelUsed::forced("exact")
+                })
+            }
+            (WaterChoice::Auto, method @ Method::Joint(j)) => {
+                let warnings = found.warnings.len();
+                self.paper(found)?;
+                if found.lights.is_empty() {
+                    return Ok(WaterModelUsed {
+                        chosen: "detected",
+                        ..WaterModelUsed::forced("exact")
+                    });
+                }
+                self.refine(
+                    &JointSettings {
+                        gloss: GlossFit::Given,
+                        ..*j
+                    },
+                    found,
+                )?;
+                let correlation = fine_structure_correlation(
+                    &self.photo.radiance,
+                    self.photo.width,
+                    &found.modelled,
+                );
+                let exact = correlation.is_none_or(|c| c >= EXACT_MIN_CORRELATION);
+                if exact {
+                    if matches!(j.gloss, GlossFit::Estimate(_)) {
+                        found.warnings.truncate(warnings);
+                        self.with_gloss_search(j, found)?;
+                    }
+                    return Ok(WaterModelUsed {
+                        chosen: "detected",
+                        fine_structure_correlation: correlation,
+                        ..WaterModelUsed::forced("exact")
+                    });
+                }
+                self.progress.stage(&format!(
+                    "the photo's fine structure does not match the scene's waves \
+                     (correlation {:.2}): fitting with the statistical water model",
+                    correlation.unwrap_or(0.0)
+                ));
+                found.warnings.truncate(warnings);
+                found.lights.clear();
+                found.uncertainties.clear();
+                found.skipped.clear();
+                self.statistical(method, found, "detected", correlation)
+            }
+        }
+    }
+
+    /// The exact model's fit: the paper's estimate, the joint fit (the gloss estimated first
+    /// when asked).
+    fn exact(&self, method: &Method, found: &mut Found) -> Result<()> {
+        match method {
+            Method::Joint(j) if matches!(j.gloss, GlossFit::Estimate(_)) => {
+                self.with_gloss_search(j, found)
+            }
+            method => {
+                self.paper(found)?;
+                if let Method::Joint(j) = method {
+                    if !found.lights.is_empty() {
+                        self.refine(j, found)?;
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// The statistical model's fit: the mean surface and the start of the slopes from the
+    /// scene's water, then the paper's estimate (the paper's method) or the slope search
+    /// with its joint fits (the joint method, whatever its gloss setting: the slopes are the
+    /// lobe).
+    fn statistical(
+        &self,
+        method: &Method,
+        found: &mut Found,
+        chosen: &'static str,
+        correlation: Option<f64>,
+    ) -> Result<WaterModelUsed> {
+        let stats =
+            water_statistics(self.scene, self.photo.width, self.photo.height).ok_or_else(|| {
+                Error::scene(
+                    &self.scene.path,
+                    format!("the camera sees no water: check {}", Setting::Water),
+                )
+            })?;
+        let gloss = self.paper.model.gloss;
+        let micro = GaussianSlopes::from_gloss(gloss).variance;
+        let mesh = stats.slope_variance;
+        let start = [micro[0] + mesh[0], micro[1] + mesh[1]];
+        let start_source = if mesh[0].max(mesh[1]) < 1e-6 {
+            format!("the water's gloss ({gloss:.0}): its mesh is flat")
+        } else {
+            format!(
+                "the water mesh's slopes ({:.2e} along, {:.2e} across) and its gloss ({gloss:.0})",
+                mesh[0], mesh[1]
+            )
+        };
+        let model = ReflectionModel {
+            gloss: MICROFACET_GLOSS,
+            ..self.paper.model
+        };
+        found.gloss = (
+            MICROFACET_GLOSS,
+            "the statistical water model's microfacets (its slope variances carry the lobe)".into(),
+        );
+        let slopes = match method {
+            Method::Paper => {
+                self.progress.stage(&format!(
+                    "fit of {} streak(s): the paper's estimate over the statistical water",
+                    self.observations.len()
+                ));
+                let f = fitting::fit_paper_with(
+                    &water_with_total(stats.surface, start),
+                    self.scene,
+                    self.photo,
+                    self.water,
+                    self.observations,
+                    &FitOptions {
+                        model,
+                        ..self.paper
+                    },
+                )?;
+                found.lights = f.lights;
+                found.skipped = f.skipped;
+                found.warnings.extend(f.warnings);
+                found.timings.extend(f.timings);
+                SlopesUsed {
+                    variance: start,
+                    sigma_ln: [None, None],
+                    start_variance: start,
+                    start_source,
+                    estimated: false,
+                }
+            }
+            Method::Joint(j) => {
+                self.progress.stage(&format!(
+                    "slope search and fit of {} streak(s) over the statistical water (each \
+                     step a joint fit)",
+                    self.observations.len()
+                ));
+                let final_fit = JointOptions {
+                    model,
+                    ..self.joint_options(j, j.reading)
+                };
+                let est = estimate_slopes(
+                    self.scene,
+                    self.photo,
+                    self.water,
+                    self.observations,
+                    stats.surface,
+                    start,
+                    &self.paper,
+                    &final_fit,
+                    &slope_search(),
+                )?;
+                found.lights = est.lights;
+                found.uncertainties = est.uncertainty;
+                found.skipped = est.skipped;
+                found.warnings.extend(est.warnings);
+                found.timings.extend(est.timings);
+                found.reading = Some(j.reading);
+                self.refit_overlaps(&est.water, &est.start, &final_fit, j, found)?;
+                SlopesUsed {
+                    variance: est.variance,
+                    sigma_ln: est.sigma_ln,
+                    start_variance: est.start_variance,
+                    start_source,
+                    estimated: true,
+                }
+            }
+        };
+        Ok(WaterModelUsed {
+            model: "statistical",
+            chosen,
+            fine_structure_correlation: correlation,
+            threshold: EXACT_MIN_CORRELATION,
+            slopes: Some(slopes),
+        })
+    }
+}
