@@ -77,6 +77,9 @@ pub struct SlopesUsed {
     /// Whether the variances were estimated from the photo (false: the start was used as
     /// it is, by the paper's method).
     pub estimated: bool,
+    /// Pixels per independent residual of the final fit (the glitter's correlation area):
+    /// every uncertainty was grown by its square root; `None` for the paper's method.
+    pub correlation_area: Option<f64>,
 }
 
 /// The correlation of the high-passed photo and model over the fitted pixels `modelled`

@@ -194,6 +194,7 @@ impl Run<'_> {
                     start_variance: start,
                     start_source,
                     estimated: false,
+                    correlation_area: None,
                 }
             }
             Method::Joint(j) => {
@@ -230,6 +231,7 @@ impl Run<'_> {
                     start_variance: est.start_variance,
                     start_source,
                     estimated: true,
+                    correlation_area: Some(est.correlation_area),
                 }
             }
         };

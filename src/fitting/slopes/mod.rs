@@ -23,9 +23,14 @@
 //! wave mesh's measured slopes plus its material's, and can move either way from it.
 //!
 //! Uncertainty: each axis's from the curvature of its last search (the gloss module's doc,
-//! "Uncertainty"), a lower bound that leaves out the axes' correlation.
+//! "Uncertainty"), and the lights' with the glitter's correlation and the slopes' own
+//! uncertainty carried in (`uncertainty`).
+
+mod uncertainty;
 
 use std::time::Instant;
+
+pub use uncertainty::{correlation_area, parameter_slopes, widen, MAX_LAG};
 
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
@@ -67,8 +72,9 @@ pub struct SlopeEstimate {
     pub water: StatisticalSurface,
     /// The total slope variances along and across (dimensionless).
     pub variance: [f32; 2],
-    /// One-sigma statistical uncertainty of the natural logarithm of each (about the relative
-    /// uncertainty); `None` where the minimum was not bracketed.
+    /// One-sigma uncertainty of the natural logarithm of each (about the relative
+    /// uncertainty), from the cost's curvature grown by the residual's correlation; `None`
+    /// where the minimum was not bracketed.
     pub sigma_ln: [Option<f32>; 2],
     /// Where the search started.
     pub start_variance: [f32; 2],
@@ -89,6 +95,9 @@ pub struct SlopeEstimate {
     pub timings: Vec<(String, f64)>,
     /// The final fit's cost (comparable between fits of the same pixels).
     pub cost: f64,
+    /// The final fit's residual correlation area, pixels per independent residual
+    /// ([`correlation_area`]): the uncertainties are grown by its square root.
+    pub correlation_area: f64,
 }
 
 /// Estimates the slope variances over `surface` from the start `start_variance` (totals,
@@ -140,10 +149,14 @@ pub fn estimate_slopes(
         ..JointOptions::new(model, paper.seed)
     };
     let mut evaluations: Vec<([f32; 2], f64)> = Vec::new();
+    // Each axis's last pass: (ln variance, the lights fitted there).
+    let mut passes: [Vec<(f64, Vec<FittedLight>)>; 2] = [Vec::new(), Vec::new()];
     let mut variance = start_variance;
     let mut sigma_ln = [None, None];
     let t = Instant::now();
-    let eval = |v: [f32; 2], evaluations: &mut Vec<([f32; 2], f64)>| -> Result<Point> {
+    let eval = |v: [f32; 2],
+                evaluations: &mut Vec<([f32; 2], f64)>|
+     -> Result<(Point, Vec<FittedLight>)> {
         final_fit.progress.stage(&format!(
             "slope search: joint fit {} at variances {:.2e} along, {:.2e} across",
             evaluations.len() + 1,
@@ -165,11 +178,14 @@ pub fn estimate_slopes(
             f64::INFINITY
         };
         evaluations.push((v, s));
-        Ok(Point {
-            x: 0.0,
-            s,
-            variance: fit.residual_variance,
-        })
+        Ok((
+            Point {
+                x: 0.0,
+                s,
+                variance: fit.residual_variance,
+            },
+            fit.lights,
+        ))
     };
     let (lo_ln, hi_ln) = ((lo as f64).ln(), (hi as f64).ln());
     let show: &dyn Fn(f64) -> String = &|v| format!("{v:.2e}");
@@ -182,6 +198,8 @@ pub fn estimate_slopes(
             }
         }
         let name = ["slope variance along", "slope variance across"][axis];
+        let pass_points = &mut passes[axis];
+        pass_points.clear();
         let found = search(
             options,
             (variance[axis] as f64).ln(),
@@ -190,7 +208,11 @@ pub fn estimate_slopes(
             |x| {
                 let mut v = variance;
                 v[axis] = x.exp() as f32;
-                eval(v, &mut evaluations).map(|p| Point { x, ..p })
+                let (p, lights) = eval(v, &mut evaluations)?;
+                if p.s.is_finite() {
+                    pass_points.push((x, lights));
+                }
+                Ok(Point { x, ..p })
             },
         )?;
         variance[axis] = found.x.exp() as f32;
@@ -237,19 +259,31 @@ pub fn estimate_slopes(
         },
     )?;
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
+    let area = correlation_area(&photo.radiance, photo.width, &fit.modelled);
+    let sigma_ln = sigma_ln.map(|s| s.map(|s| s * area.sqrt() as f32));
+    let lights = fit.lights_with_statuses();
+    let mut uncertainty = fit.uncertainty;
+    let by_axis = passes.map(|p| parameter_slopes(&p));
+    widen(
+        &mut uncertainty,
+        area,
+        [by_axis[0].as_ref(), by_axis[1].as_ref()],
+        sigma_ln,
+    );
     Ok(SlopeEstimate {
         water: at,
         variance,
         sigma_ln,
         start_variance,
         evaluations,
-        lights: fit.lights_with_statuses(),
-        uncertainty: fit.uncertainty,
+        lights,
+        uncertainty,
         start: paper_fit.lights,
         skipped: paper_fit.skipped,
         warnings,
         timings,
         cost: fit.cost,
+        correlation_area: area,
     })
 }
 

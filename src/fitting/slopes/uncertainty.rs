@@ -1,0 +1,210 @@
+//! How far the statistical model's lights can be trusted (method §10).
+//!
+//! The joint fit's uncertainties assume each pixel's residual independent of its neighbours'.
+//! Under the statistical model the residual is the photo's glitter about its expectation, and
+//! a wave facet lights many neighbouring pixels at once: near the camera, in the paper's close
+//! geometry, one of the longest waves tilts a whole streak. So the residual's correlation is
+//! measured, and every uncertainty grows by the square root of its correlation area (the
+//! pixels per independent residual: the sum of the residual's autocorrelation over lags up
+//! to [`MAX_LAG`] pixels each way, at least 1), the effective sample size argument for a
+//! least-squares fit with correlated errors.
+//!
+//! The lights also move with the slope variances, which are estimated with an uncertainty of
+//! their own: each light parameter's derivative by the logarithm of each variance (a
+//! least-squares line through the search's last pass on that axis, every fit of which
+//! re-optimised the lights) times that variance's uncertainty is added in quadrature.
+
+use std::collections::HashMap;
+
+use crate::fitting::joint::Uncertainty;
+use crate::fitting::EdgeSide;
+use crate::fitting::FittedLight;
+
+/// The largest lag, in pixels along each axis, of the residual's correlation area.
+pub const MAX_LAG: i64 = 8;
+
+/// The residual's correlation area, in pixels: the sum of its autocorrelation over lags
+/// within `MAX_LAG` each way (lag 0 counts 1), over the fitted pixels `modelled` of a
+/// `width`-wide `photo` (sum of channels); at least 1.
+pub fn correlation_area(photo: &[[f32; 3]], width: u32, modelled: &[(u32, [f32; 3])]) -> f64 {
+    let w = width as i64;
+    let residual: HashMap<i64, f64> = modelled
+        .iter()
+        .map(|&(p, m)| {
+            let o = photo.get(p as usize).copied().unwrap_or([0.0; 3]);
+            let r = (o[0] + o[1] + o[2]) as f64 - (m[0] + m[1] + m[2]) as f64;
+            (p as i64, r)
+        })
+        .collect();
+    if residual.len() < 2 || w == 0 {
+        return 1.0;
+    }
+    let mean = residual.values().sum::<f64>() / residual.len() as f64;
+    let var = residual.values().map(|r| (r - mean).powi(2)).sum::<f64>() / residual.len() as f64;
+    if var <= 0.0 {
+        return 1.0;
+    }
+    let mut area = 0.0;
+    for dy in -MAX_LAG..=MAX_LAG {
+        for dx in -MAX_LAG..=MAX_LAG {
+            let (mut sum, mut n) = (0.0, 0usize);
+            for (&p, &r) in &residual {
+                let (x, y) = (p % w, p / w);
+                let (qx, qy) = (x + dx, y + dy);
+                if qx < 0 || qx >= w || qy < 0 {
+                    continue;
+                }
+                if let Some(&s) = residual.get(&(qy * w + qx)) {
+                    sum += (r - mean) * (s - mean);
+                    n += 1;
+                }
+            }
+            if n > 0 {
+                area += sum / n as f64 / var;
+            }
+        }
+    }
+    area.max(1.0)
+}
+
+/// The least-squares slope of each light's parameters (left, right, bottom, top edges, then
+/// the three radiances) against `x`, over `points` (x and the lights fitted there, all with
+/// the same lights in the same order); `None` with fewer than two distinct x.
+pub fn parameter_slopes(points: &[(f64, Vec<FittedLight>)]) -> Option<Vec<[f64; 7]>> {
+    let n = points.len() as f64;
+    if points.len() < 2 {
+        return None;
+    }
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    if sxx <= 1e-12 {
+        return None;
+    }
+    let lights = points[0].1.len();
+    if points.iter().any(|p| p.1.len() != lights) {
+        return None;
+    }
+    let params = |l: &FittedLight| -> [f64; 7] {
+        [
+            l.u_min as f64,
+            l.u_max as f64,
+            l.v_min as f64,
+            l.v_max as f64,
+            l.radiance[0] as f64,
+            l.radiance[1] as f64,
+            l.radiance[2] as f64,
+        ]
+    };
+    Some(
+        (0..lights)
+            .map(|k| {
+                let mut slope = [0.0; 7];
+                let mean: Vec<f64> = (0..7)
+                    .map(|i| points.iter().map(|p| params(&p.1[k])[i]).sum::<f64>() / n)
+                    .collect();
+                for (i, s) in slope.iter_mut().enumerate() {
+                    let sxy: f64 = points
+                        .iter()
+                        .map(|p| (p.0 - mx) * (params(&p.1[k])[i] - mean[i]))
+                        .sum();
+                    *s = sxy / sxx;
+                }
+                slope
+            })
+            .collect(),
+    )
+}
+
+/// `uncertainty` of each light grown by `sqrt(area)` (the residual's correlation area), with
+/// the slope variances' uncertainties `sigma_ln` (already so grown) carried through the
+/// parameters' `slopes` by `ln` variance, per axis. Unconstrained edges stay unconstrained.
+pub fn widen(
+    uncertainty: &mut [Uncertainty],
+    area: f64,
+    slopes: [Option<&Vec<[f64; 7]>>; 2],
+    sigma_ln: [Option<f32>; 2],
+) {
+    let grow = area.max(1.0).sqrt();
+    for (k, u) in uncertainty.iter_mut().enumerate() {
+        let carried = |i: usize| -> f64 {
+            (0..2)
+                .map(|a| match (slopes[a].and_then(|s| s.get(k)), sigma_ln[a]) {
+                    (Some(s), Some(sd)) => (s[i] * sd as f64).powi(2),
+                    _ => 0.0,
+                })
+                .sum()
+        };
+        for side in EdgeSide::ALL {
+            let i = side as usize;
+            u.edges[side] =
+                u.edges[side].map(|sd| ((sd as f64 * grow).powi(2) + carried(i)).sqrt() as f32);
+        }
+        for c in 0..3 {
+            u.radiance[c] = ((u.radiance[c] as f64 * grow).powi(2) + carried(4 + c)).sqrt() as f32;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// White noise has a correlation area of 1; noise constant over 2 x 2 blocks, of 4 (the
+    /// pixels per independent value), up to the edges of the lag window.
+    #[test]
+    fn correlation_area_counts_pixels_per_independent_value() {
+        let (w, h) = (96u32, 96u32);
+        let hash = |i: u32| {
+            let v = i
+                .wrapping_mul(2_654_435_761)
+                .rotate_left(13)
+                .wrapping_mul(40_503);
+            (v >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        let white: Vec<[f32; 3]> = (0..w * h).map(|p| [hash(p); 3]).collect();
+        let blocks: Vec<[f32; 3]> = (0..w * h)
+            .map(|p| [hash((p % w) / 2 + 1000 * ((p / w) / 2)); 3])
+            .collect();
+        let zero: Vec<(u32, [f32; 3])> = (0..w * h).map(|p| (p, [0.0; 3])).collect();
+        let a = correlation_area(&white, w, &zero);
+        let b = correlation_area(&blocks, w, &zero);
+        assert!(a < 1.6, "{a}");
+        assert!((b - 4.0).abs() < 0.8, "{b}");
+    }
+
+    #[test]
+    fn slopes_of_a_line_and_widening_in_quadrature() {
+        use crate::fitting::light_plane::LightPlane;
+        use crate::fitting::EdgeStatus;
+        use glam::Vec3;
+        let plane = LightPlane::with_frame((0, 0, 0), Vec3::ZERO, Vec3::Z, Vec3::X, 1.0).unwrap();
+        let light = |x: f64| FittedLight {
+            streak_ids: vec![0],
+            plane: plane.clone(),
+            u_min: (1.0 + 0.5 * x) as f32,
+            u_max: 3.0,
+            v_min: 0.0,
+            v_max: 2.0,
+            radiance: [(10.0 - 2.0 * x) as f32; 3],
+            edges: std::array::from_fn(|_| EdgeStatus::Constrained { pixels: 1 }),
+        };
+        let pts: Vec<(f64, Vec<FittedLight>)> = [-0.2, 0.0, 0.3]
+            .iter()
+            .map(|&x| (x, vec![light(x)]))
+            .collect();
+        let s = parameter_slopes(&pts).unwrap();
+        assert!(
+            (s[0][0] - 0.5).abs() < 1e-5 && (s[0][4] + 2.0).abs() < 1e-4,
+            "{s:?}"
+        );
+        let mut u = vec![Uncertainty {
+            edges: [Some(0.03), None, Some(0.01), Some(0.01)],
+            radiance: [0.1; 3],
+        }];
+        widen(&mut u, 4.0, [Some(&s), None], [Some(0.1), None]);
+        // Left: (0.03 * 2)^2 + (0.5 * 0.1)^2; radiance: (0.1 * 2)^2 + (2 * 0.1)^2.
+        assert!((u[0].edges[EdgeSide::Left].unwrap() - 0.0781).abs() < 1e-3);
+        assert_eq!(u[0].edges[EdgeSide::Right], None);
+        assert!((u[0].radiance[0] - 0.2828).abs() < 1e-3);
+    }
+}
