@@ -148,7 +148,7 @@ mod tests {
         // Pseudo-random glints from a hash of the pixel index.
         let glint = |p: u32, salt: u32| {
             let v = (p.wrapping_mul(2_654_435_761) ^ salt).wrapping_mul(40_503) >> 16;
-            if v % 7 == 0 {
+            if v.is_multiple_of(7) {
                 2.0
             } else {
                 0.0
