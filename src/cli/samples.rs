@@ -17,6 +17,10 @@ pub struct Args {
     /// Camera rays per pixel of the photos.
     #[arg(long, default_value_t = samples::PHOTO_SPP)]
     pub spp: u32,
+    /// Render only this photo (a file name such as `table1.png`; repeatable). By default
+    /// every photo.
+    #[arg(long = "photo", value_name = "NAME")]
+    pub photos: Vec<String>,
 }
 
 /// Runs the command.
@@ -26,7 +30,9 @@ pub fn run(args: Args) -> streaklight::Result<()> {
     }
     if !args.scenes_only {
         let terminal = super::progress::Terminal::new();
-        for path in samples::render_photos(&args.dir, args.spp, Reporter::new(&terminal))? {
+        for path in
+            samples::render_photos(&args.dir, args.spp, &args.photos, Reporter::new(&terminal))?
+        {
             eprintln!("wrote {}", path.display());
         }
     }

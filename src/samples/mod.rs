@@ -1,9 +1,13 @@
-//! The sample scenes of the paper's setup (method §6), generated deterministically.
+//! The sample scenes of the paper's setup (method §6) and of a harbour ([`harbour`]),
+//! generated deterministically.
 //!
 //! Camera at (0, 0.2, 10) looking down -z, vertical fov 60 degrees, 600 x 600; a wall at
-//! z = 0 (or moved, for Table 2); a rippled water height field in front of it. The shared
-//! water mesh is large (about 12 MB), so it is generated rather than committed; the
-//! scenes are small JSON files and the photos small PNGs.
+//! z = 0 (or moved, for Table 2); a rippled water height field in front of it. The water
+//! meshes are large (about 12 MB each), so they are generated rather than committed; the
+//! scenes are small JSON files and the photos small PNGs. Fitting scenes whose water is not
+//! the photos' come with both setups: another realisation of the same waves
+//! ([`SampleWater::OtherWaves`]) and one flat quad with a matching roughness
+//! ([`SampleWater::Flat`], [`flat_gloss`]).
 //!
 //! Besides the paper's Tables 1 to 3, truth scenes with photos for cases the paper does not
 //! show: Table 1's light over rougher and smoother water ([`SAMPLE_GLOSSES`]:
@@ -13,19 +17,21 @@
 //! Table 1's photo as linear float, from the same render as `table1.png` (large, so not
 //! committed).
 
+pub mod gltf_doc;
+pub mod harbour;
+pub mod harbour_waves;
 pub mod shapes;
 pub mod water_surface;
 
 use std::path::{Path, PathBuf};
 
-use base64::Engine;
 use glam::DVec3;
-use serde_json::{json, Value};
 
 use crate::output_file::write_atomically;
-use crate::scene_in::roughness_from_gloss;
 use crate::{Error, Result};
 
+use gltf_doc::{CameraPose, Quad, SceneParts, Solid, WaterBuffer, WaterGeometry};
+use harbour::Framing;
 use water_surface::{GridSpec, RippleField};
 
 /// The paper's camera position.
@@ -41,6 +47,8 @@ pub const PHOTO_EXPOSURE: f32 = 0.1;
 pub const PHOTO_SPP: u32 = 256;
 /// File name of the generated water mesh.
 pub const WATER_BIN: &str = "water.bin";
+/// File name of the generated water mesh of the other ripples ([`other_ripples`]).
+pub const OTHER_WATER_BIN: &str = "water-other.bin";
 /// Gloss (Phong exponent e) of the samples' water, unless a scene says otherwise.
 pub const DEFAULT_GLOSS: f64 = 500.0;
 /// Water gloss of the gloss samples `gloss200-truth.gltf` (`gloss200.png`) and
@@ -73,7 +81,9 @@ pub struct SampleLight {
 }
 
 impl SampleLight {
-    fn new(name: &str, corner: [f64; 3], size: [f64; 2], radiance: [f64; 3]) -> Self {
+    /// A light named `name` with left-bottom corner `corner`, `size` = (width, height) and
+    /// linear radiance `radiance`.
+    pub fn new(name: &str, corner: [f64; 3], size: [f64; 2], radiance: [f64; 3]) -> Self {
         SampleLight {
             name: name.into(),
             corner: DVec3::from(corner),
@@ -120,6 +130,30 @@ pub struct SampleScene {
     /// The same render written as linear float OpenEXR too, if any (radiance times the
     /// exposure, unclipped).
     pub photo_exr: Option<String>,
+    /// Which camera and surroundings.
+    pub setup: Setup,
+    /// Which water.
+    pub water: SampleWater,
+}
+
+/// The geometry a sample scene is set in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Setup {
+    /// The paper's: camera 0.2 m above the water, 10 m from the wall.
+    Paper,
+    /// The harbour's ([`harbour`]), in one of its framings.
+    Harbour(Framing),
+}
+
+/// The water of a sample scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleWater {
+    /// The setup's waves: the ones its photos are rendered over.
+    Waves,
+    /// Another realisation of the same wave statistics (what an artist's scene would hold).
+    OtherWaves,
+    /// One flat quad, its roughness matching the waves' slopes (what a game scene holds).
+    Flat,
 }
 
 /// Table 1's light (corner (-4, 2, 0), 3 x 3, L = 20).
@@ -180,6 +214,8 @@ pub fn catalogue() -> Vec<SampleScene> {
             lights,
             photo: photo.map(str::to_owned),
             photo_exr: None,
+            setup: Setup::Paper,
+            water: SampleWater::Waves,
         }
     };
     let gloss_samples = SAMPLE_GLOSSES.map(|gloss| {
@@ -251,7 +287,42 @@ pub fn catalogue() -> Vec<SampleScene> {
             Some("stacked1000.png"),
         )
     });
+    scenes.push(SampleScene {
+        water: SampleWater::OtherWaves,
+        ..scene(
+            "scene-other-waves.gltf",
+            "the paper's setup over another realisation of its ripples, without lights: the input of a fit",
+            0.0,
+            vec![],
+            None,
+        )
+    });
+    scenes.push(SampleScene {
+        water: SampleWater::Flat,
+        gloss: flat_gloss(&ripples(), DEFAULT_GLOSS),
+        ..scene(
+            "scene-flat.gltf",
+            "the paper's setup over a flat quad whose roughness matches the ripples' slopes, without lights: the input of a fit",
+            0.0,
+            vec![],
+            None,
+        )
+    });
+    scenes.extend(harbour::catalogue(flat_gloss(
+        &harbour::harbour_waves(0),
+        harbour::HARBOUR_GLOSS,
+    )));
     scenes
+}
+
+/// The gloss e of flat water whose isotropic roughness matches `field`'s slopes on top of
+/// a micro-roughness of gloss `gloss` (method §3): a Beckmann alpha has slope variance
+/// alpha^2 / 2 per axis, and e = 2 / alpha^2 - 2; the flat water's alpha^2 is the
+/// micro-roughness's plus the field's slope variance over both axes.
+pub fn flat_gloss(field: &RippleField, gloss: f64) -> f64 {
+    let slopes = field.slope_variances([0.0, 1.0]);
+    let alpha2 = 2.0 / (gloss + 2.0) + slopes.along + slopes.across;
+    2.0 / alpha2 - 2.0
 }
 
 impl SampleScene {
@@ -276,175 +347,131 @@ pub fn water_grid() -> GridSpec {
     }
 }
 
-/// The ripples of every sample.
+/// The ripples of every sample photo.
 pub fn ripples() -> RippleField {
     RippleField::new(2018, 24, 0.05)
 }
 
-/// Byte layout of the water buffer.
-struct WaterBuffer {
-    bytes: Vec<u8>,
-    vertex_count: usize,
-    index_count: usize,
-    min: [f32; 3],
-    max: [f32; 3],
+/// Another realisation of the same ripples: the water of `scene-other-waves.gltf`.
+pub fn other_ripples() -> RippleField {
+    RippleField::new(1202, 24, 0.05)
 }
 
-fn water_buffer() -> WaterBuffer {
-    let mesh = water_surface::mesh(&ripples(), &water_grid());
-    let mut bytes = Vec::with_capacity(mesh.positions.len() * 24 + mesh.indices.len() * 4);
-    let mut min = [f32::INFINITY; 3];
-    let mut max = [f32::NEG_INFINITY; 3];
-    for p in &mesh.positions {
-        for c in 0..3 {
-            min[c] = min[c].min(p[c]);
-            max[c] = max[c].max(p[c]);
-            bytes.extend_from_slice(&p[c].to_le_bytes());
-        }
-    }
-    for n in &mesh.normals {
-        for c in n {
-            bytes.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for i in &mesh.indices {
-        bytes.extend_from_slice(&i.to_le_bytes());
-    }
-    WaterBuffer {
-        bytes,
-        vertex_count: mesh.positions.len(),
-        index_count: mesh.indices.len(),
-        min,
-        max,
-    }
-}
-
-/// A quad for the wall at `z`, facing +z, as a data URI buffer.
-fn wall_buffer(z: f64) -> (String, usize) {
+/// The wall of the paper's setup at `z`, facing +z.
+fn paper_wall(z: f64) -> Solid {
     let (x0, x1, y0, y1) = (-40.0f32, 40.0f32, -1.0f32, 25.0f32);
     let z = z as f32;
-    let positions = [[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]];
-    let mut bytes = Vec::new();
-    for p in positions {
-        for c in p {
-            bytes.extend_from_slice(&c.to_le_bytes());
-        }
+    Solid {
+        name: "Wall".into(),
+        quads: vec![Quad {
+            corners: [[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]],
+            normal: [0.0, 0.0, 1.0],
+        }],
     }
-    for _ in 0..4 {
-        for c in [0f32, 0.0, 1.0] {
-            bytes.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for i in [0u16, 1, 2, 0, 2, 3] {
-        bytes.extend_from_slice(&i.to_le_bytes());
-    }
-    let len = bytes.len();
-    (
-        format!(
-            "data:application/octet-stream;base64,{}",
-            base64::engine::general_purpose::STANDARD.encode(&bytes)
-        ),
-        len,
-    )
 }
 
-fn scene_json(spec: &SampleScene, water: &WaterBuffer) -> Value {
-    let (wall_uri, wall_len) = wall_buffer(spec.wall_z);
-    let wz = spec.wall_z as f32;
-    let (vc, ic) = (water.vertex_count, water.index_count);
-    let mut nodes = vec![
-        json!({"name": "Camera", "camera": 0, "translation": CAMERA_POSITION}),
-        json!({"name": "Water", "mesh": 0}),
-        json!({"name": "Wall", "mesh": 1}),
-    ];
-    let mut root_nodes: Vec<usize> = vec![0, 1, 2];
-    let mut lights = Vec::new();
-    for (i, light) in spec.lights.iter().enumerate() {
-        let max = light.radiance.iter().cloned().fold(0.0, f64::max);
-        let color = if max > 0.0 {
-            light.radiance.map(|c| c / max)
-        } else {
-            [1.0; 3]
-        };
-        lights.push(json!({
-            "name": light.name, "type": "rect", "color": color, "intensity": max,
-            "size": light.height, "rect": {"aspect": light.width / light.height}
-        }));
-        root_nodes.push(nodes.len());
-        // Emission is along local -Z; a half turn about Y makes it face +z, the water.
-        nodes.push(json!({
-            "name": light.name,
-            "translation": light.center().to_array(),
-            "rotation": [0.0, 1.0, 0.0, 0.0],
-            "extensions": {"EXT_lights_area": {"light": i}}
-        }));
+/// The flat water of the paper's setup: one quad over the water grid's extent.
+fn paper_flat_water() -> Quad {
+    let grid = water_grid();
+    let (near, far) = (
+        (grid.eye_z - grid.near) as f32,
+        (grid.eye_z - grid.far) as f32,
+    );
+    let w = (grid.half_width_per_distance * grid.far) as f32;
+    Quad {
+        corners: [
+            [-w, 0.0, near],
+            [w, 0.0, near],
+            [w, 0.0, far],
+            [-w, 0.0, far],
+        ],
+        normal: [0.0, 1.0, 0.0],
     }
-    let mut doc = json!({
-        "asset": {"version": "2.0", "generator": "streaklight samples"},
-        "extensionsUsed": ["KHR_materials_ior"],
-        "scene": 0,
-        "scenes": [{"name": spec.description, "nodes": root_nodes}],
-        "nodes": nodes,
-        "cameras": [{"name": "PaperCamera", "type": "perspective", "perspective": {
-            "yfov": CAMERA_YFOV_DEGREES.to_radians(), "aspectRatio": 1.0, "znear": 0.01, "zfar": 200.0}}],
-        "materials": [
-            {"name": "Water", "pbrMetallicRoughness": {"baseColorFactor": [0.02, 0.03, 0.04, 1.0],
-                "metallicFactor": 0.0, "roughnessFactor": roughness_from_gloss(spec.gloss as f32)},
-             "extensions": {"KHR_materials_ior": {"ior": crate::scene_in::WATER_IOR}}},
-            {"name": "Wall", "pbrMetallicRoughness": {"baseColorFactor": [0.05, 0.05, 0.05, 1.0],
-                "metallicFactor": 0.0, "roughnessFactor": 1.0}}
-        ],
-        "meshes": [
-            {"name": "Water", "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}]},
-            {"name": "Wall", "primitives": [{"attributes": {"POSITION": 3, "NORMAL": 4}, "indices": 5, "material": 1}]}
-        ],
-        "buffers": [
-            {"uri": WATER_BIN, "byteLength": water.bytes.len()},
-            {"uri": wall_uri, "byteLength": wall_len}
-        ],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": vc * 12, "target": 34962},
-            {"buffer": 0, "byteOffset": vc * 12, "byteLength": vc * 12, "target": 34962},
-            {"buffer": 0, "byteOffset": vc * 24, "byteLength": ic * 4, "target": 34963},
-            {"buffer": 1, "byteOffset": 0, "byteLength": 48, "target": 34962},
-            {"buffer": 1, "byteOffset": 48, "byteLength": 48, "target": 34962},
-            {"buffer": 1, "byteOffset": 96, "byteLength": 12, "target": 34963}
-        ],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": vc, "type": "VEC3", "min": water.min, "max": water.max},
-            {"bufferView": 1, "componentType": 5126, "count": vc, "type": "VEC3"},
-            {"bufferView": 2, "componentType": 5125, "count": ic, "type": "SCALAR"},
-            {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-40.0, -1.0, wz], "max": [40.0, 25.0, wz]},
-            {"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC3"},
-            {"bufferView": 5, "componentType": 5123, "count": 6, "type": "SCALAR"}
+}
+
+/// The generated water meshes, by setup and realisation.
+struct WaterBuffers {
+    paper: [WaterBuffer; 2],
+    harbour: [WaterBuffer; 2],
+}
+
+impl WaterBuffers {
+    fn new() -> Self {
+        let paper =
+            |field: &RippleField| WaterBuffer::new(&water_surface::mesh(field, &water_grid()));
+        WaterBuffers {
+            paper: [paper(&ripples()), paper(&other_ripples())],
+            harbour: [0, 1].map(|r| WaterBuffer::new(&harbour::water_mesh(r))),
+        }
+    }
+
+    /// The files the buffers are written to, with their bytes.
+    fn files(&self) -> [(&'static str, &WaterBuffer); 4] {
+        [
+            (WATER_BIN, &self.paper[0]),
+            (OTHER_WATER_BIN, &self.paper[1]),
+            (harbour::HARBOUR_WATER_BIN, &self.harbour[0]),
+            (harbour::HARBOUR_OTHER_WATER_BIN, &self.harbour[1]),
         ]
-    });
-    if !lights.is_empty() {
-        if let Some(root) = doc.as_object_mut() {
-            root.insert(
-                "extensions".into(),
-                json!({"EXT_lights_area": {"lights": lights}}),
-            );
-            if let Some(used) = root.get_mut("extensionsUsed").and_then(Value::as_array_mut) {
-                used.push(json!("EXT_lights_area"));
-            }
-        }
     }
-    doc
 }
 
-/// Writes the water mesh and every sample scene into `dir`; returns the files written.
+/// The parts of `spec`'s scene file.
+fn scene_parts<'a>(spec: &'a SampleScene, buffers: &'a WaterBuffers) -> SceneParts<'a> {
+    let (camera, solids, flat, meshes, uris) = match spec.setup {
+        Setup::Paper => (
+            CameraPose {
+                name: "PaperCamera".into(),
+                translation: CAMERA_POSITION,
+                pitch_degrees: 0.0,
+                yfov_degrees: CAMERA_YFOV_DEGREES,
+            },
+            vec![paper_wall(spec.wall_z)],
+            paper_flat_water(),
+            &buffers.paper,
+            [WATER_BIN, OTHER_WATER_BIN],
+        ),
+        Setup::Harbour(framing) => (
+            harbour::camera(framing),
+            harbour::solids(),
+            harbour::flat_water(),
+            &buffers.harbour,
+            [harbour::HARBOUR_WATER_BIN, harbour::HARBOUR_OTHER_WATER_BIN],
+        ),
+    };
+    let mesh = |i: usize| WaterGeometry::Mesh {
+        uri: uris[i],
+        buffer: &meshes[i],
+    };
+    SceneParts {
+        description: &spec.description,
+        camera,
+        water: match spec.water {
+            SampleWater::Waves => mesh(0),
+            SampleWater::OtherWaves => mesh(1),
+            SampleWater::Flat => WaterGeometry::Flat(flat),
+        },
+        gloss: spec.gloss,
+        solids,
+        lights: &spec.lights,
+    }
+}
+
+/// Writes the water meshes and every sample scene into `dir`; returns the files written.
 pub fn write_scenes(dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let water = water_buffer();
+    let buffers = WaterBuffers::new();
     let mut written = Vec::new();
-    let bin = dir.join(WATER_BIN);
-    write_atomically(&bin, &water.bytes)?;
-    written.push(bin);
+    for (file, buffer) in buffers.files() {
+        let bin = dir.join(file);
+        write_atomically(&bin, &buffer.bytes)?;
+        written.push(bin);
+    }
     for spec in catalogue() {
         let path = dir.join(&spec.file);
-        let text = serde_json::to_string_pretty(&scene_json(&spec, &water))
-            .map_err(|e| Error::output(&path, e.to_string()))?;
+        let text =
+            serde_json::to_string_pretty(&gltf_doc::scene_json(&scene_parts(&spec, &buffers)))
+                .map_err(|e| Error::output(&path, e.to_string()))?;
         write_atomically(&path, text.as_bytes())?;
         written.push(path);
     }
@@ -473,15 +500,34 @@ pub fn render_photo(
 }
 
 /// Renders the photo of every sample scene that has one (the scenes must be written
-/// already), with `spp` camera rays per pixel; returns the files written.
+/// already), or only those named in `only` when it is not empty, with `spp` camera rays per
+/// pixel; returns the files written.
 pub fn render_photos(
     dir: &Path,
     spp: u32,
+    only: &[String],
     progress: crate::progress::Reporter<'_>,
 ) -> Result<Vec<PathBuf>> {
+    let catalogue = catalogue();
+    if let Some(unknown) = only
+        .iter()
+        .find(|name| !catalogue.iter().any(|s| s.photo.as_ref() == Some(name)))
+    {
+        return Err(Error::Usage(format!(
+            "no sample photo is named {unknown}; the photos are: {}",
+            catalogue
+                .iter()
+                .filter_map(|s| s.photo.as_deref())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
     let mut written = Vec::new();
-    for spec in catalogue() {
+    for spec in catalogue {
         let Some(photo) = &spec.photo else { continue };
+        if !only.is_empty() && !only.contains(photo) {
+            continue;
+        }
         progress.stage(&format!("rendering {photo}"));
         let image = render_photo(dir, &spec, spp, progress)?;
         let path = dir.join(photo);

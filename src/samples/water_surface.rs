@@ -12,13 +12,28 @@ use glam::DVec3;
 
 use crate::random::Rng;
 
-/// One sinusoidal ripple.
+/// One sinusoidal ripple: height `amplitude * sin(k . (x, z) + phase)`.
 #[derive(Clone, Copy, Debug)]
-struct Ripple {
+pub struct Ripple {
     /// Wave vector (radians per metre) in (x, z).
-    k: [f64; 2],
-    amplitude: f64,
-    phase: f64,
+    pub k: [f64; 2],
+    /// Height amplitude (metres).
+    pub amplitude: f64,
+    /// Phase (radians).
+    pub phase: f64,
+}
+
+/// Slope statistics of a water surface along a horizontal unit axis u = (u_x, u_z) and across
+/// it, along v = (-u_z, u_x): the direction to the right of someone looking along u (for
+/// u = -z, the samples' view direction, v = +x).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlopeVariances {
+    /// Variance of the slope dh/du.
+    pub along: f64,
+    /// Variance of the slope dh/dv.
+    pub across: f64,
+    /// Covariance of the two.
+    pub covariance: f64,
 }
 
 /// The height field h(x, z) of the water around y = 0.
@@ -49,6 +64,39 @@ impl RippleField {
             })
             .collect();
         RippleField { ripples }
+    }
+
+    /// The field made of `ripples`.
+    pub fn from_ripples(ripples: Vec<Ripple>) -> Self {
+        RippleField { ripples }
+    }
+
+    /// The ripples, unfiltered.
+    pub fn ripples(&self) -> &[Ripple] {
+        &self.ripples
+    }
+
+    /// The exact slope variances of the unfiltered field along the horizontal unit axis
+    /// `axis` = (u_x, u_z) and across it, over the whole plane: a ripple a sin(k . x + phase)
+    /// has slope a (k . u) cos(k . x + phase) along u, of mean square a^2 (k . u)^2 / 2, and
+    /// ripples with different wave vectors are uncorrelated over the plane.
+    pub fn slope_variances(&self, axis: [f64; 2]) -> SlopeVariances {
+        let norm = axis[0].hypot(axis[1]);
+        let (ux, uz) = (axis[0] / norm, axis[1] / norm);
+        let mut out = SlopeVariances {
+            along: 0.0,
+            across: 0.0,
+            covariance: 0.0,
+        };
+        for r in &self.ripples {
+            let ku = r.k[0] * ux + r.k[1] * uz;
+            let kv = -r.k[0] * uz + r.k[1] * ux;
+            let half_a2 = 0.5 * r.amplitude * r.amplitude;
+            out.along += half_a2 * ku * ku;
+            out.across += half_a2 * kv * kv;
+            out.covariance += half_a2 * ku * kv;
+        }
+        out
     }
 
     /// Height and its gradient (dh/dx, dh/dz) at (x, z), each ripple attenuated by a
@@ -103,32 +151,58 @@ pub struct GridSpec {
     pub columns: usize,
 }
 
-/// Meshes `field` on the grid `spec`.
+/// One row of a water grid: `columns + 1` vertices at `z`, evenly spaced over
+/// [-half_width, half_width].
+#[derive(Clone, Copy, Debug)]
+pub struct GridRow {
+    /// The row's z.
+    pub z: f64,
+    /// The spacing to the neighbouring rows (the prefilter's scale along z).
+    pub dz: f64,
+    /// Half the row's width along x.
+    pub half_width: f64,
+}
+
+/// Meshes `field` on the grid `spec`, with the prefilter's Gaussian as wide as the grid's
+/// spacing.
 pub fn mesh(field: &RippleField, spec: &GridSpec) -> WaterMesh {
     // Rows uniform in the tangent of the angle below the horizon, as image rows are.
     let (t_near, t_far) = (spec.eye_height / spec.near, spec.eye_height / spec.far);
     let row_distance =
         |j: f64| spec.eye_height / (t_near + (t_far - t_near) * j / spec.rows as f64);
-    let (nr, nc) = (spec.rows + 1, spec.columns + 1);
-    let mut positions = Vec::with_capacity(nr * nc);
-    let mut normals = Vec::with_capacity(nr * nc);
-    for j in 0..nr {
-        let d = row_distance(j as f64);
-        let dz = (row_distance(j as f64 + 0.5) - row_distance(j as f64 - 0.5)).abs();
-        let half_width = spec.half_width_per_distance * d;
-        let dx = 2.0 * half_width / spec.columns as f64;
-        let z = spec.eye_z - d;
+    let rows: Vec<GridRow> = (0..=spec.rows)
+        .map(|j| {
+            let d = row_distance(j as f64);
+            GridRow {
+                z: spec.eye_z - d,
+                dz: (row_distance(j as f64 + 0.5) - row_distance(j as f64 - 0.5)).abs(),
+                half_width: spec.half_width_per_distance * d,
+            }
+        })
+        .collect();
+    mesh_rows(field, &rows, spec.columns, 1.0)
+}
+
+/// Meshes `field` on `rows` (near to far, each with `columns` intervals), every ripple
+/// attenuated by a Gaussian prefilter of `filter` times the local spacing along x and z.
+pub fn mesh_rows(field: &RippleField, rows: &[GridRow], columns: usize, filter: f64) -> WaterMesh {
+    let nc = columns + 1;
+    let mut positions = Vec::with_capacity(rows.len() * nc);
+    let mut normals = Vec::with_capacity(rows.len() * nc);
+    for row in rows {
+        let dx = 2.0 * row.half_width / columns as f64;
         for i in 0..nc {
-            let x = -half_width + dx * i as f64;
-            let (h, gx, gz) = field.sample(x, z, dx, dz);
+            let x = -row.half_width + dx * i as f64;
+            let (h, gx, gz) = field.sample(x, row.z, dx * filter, row.dz * filter);
             let n = DVec3::new(-gx, 1.0, -gz).normalize();
-            positions.push([x as f32, h as f32, z as f32]);
+            positions.push([x as f32, h as f32, row.z as f32]);
             normals.push([n.x as f32, n.y as f32, n.z as f32]);
         }
     }
-    let mut indices = Vec::with_capacity(spec.rows * spec.columns * 6);
-    for j in 0..spec.rows {
-        for i in 0..spec.columns {
+    let intervals = rows.len().saturating_sub(1);
+    let mut indices = Vec::with_capacity(intervals * columns * 6);
+    for j in 0..intervals {
+        for i in 0..columns {
             let a = (j * nc + i) as u32; // near row, left
             let b = a + 1; // near row, right
             let c = a + nc as u32; // far row, left
@@ -141,6 +215,60 @@ pub fn mesh(field: &RippleField, spec: &GridSpec) -> WaterMesh {
         positions,
         normals,
         indices,
+    }
+}
+
+impl WaterMesh {
+    /// The area-weighted slope variances of the mesh's shading normals along the horizontal
+    /// unit axis `axis` and across it (as [`RippleField::slope_variances`]), over the
+    /// triangles whose centroid `keep` accepts. Within a triangle the slopes (-n_x / n_y,
+    /// -n_z / n_y) are taken as linear between its corners, whose mean square over the
+    /// triangle is (sum of s_i^2 + sum over pairs of s_i s_j) / 6; the renderer interpolates
+    /// the normals themselves, which differs from this by terms of third order in the slope.
+    /// The variances are about the mean slope over the kept area.
+    pub fn slope_variances(&self, axis: [f64; 2], keep: impl Fn(DVec3) -> bool) -> SlopeVariances {
+        let norm = axis[0].hypot(axis[1]);
+        let (ux, uz) = (axis[0] / norm, axis[1] / norm);
+        let slopes = |i: u32| {
+            let n = self.normals[i as usize].map(f64::from);
+            let (sx, sz) = (-n[0] / n[1], -n[2] / n[1]);
+            (sx * ux + sz * uz, -sx * uz + sz * ux)
+        };
+        // Sums of area, area * mean, area * mean square (u, v, u v).
+        let mut sums = [0.0f64; 6];
+        for t in self.indices.chunks_exact(3) {
+            let p = |i: u32| DVec3::from(self.positions[i as usize].map(f64::from));
+            let (p0, p1, p2) = (p(t[0]), p(t[1]), p(t[2]));
+            if !keep((p0 + p1 + p2) / 3.0) {
+                continue;
+            }
+            let e1 = p1 - p0;
+            let e2 = p2 - p0;
+            let area = 0.5 * (e1.z * e2.x - e1.x * e2.z).abs();
+            let s = [slopes(t[0]), slopes(t[1]), slopes(t[2])];
+            let second = |f: &dyn Fn((f64, f64)) -> f64| {
+                let v = s.map(f);
+                (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[0] * v[1] + v[0] * v[2] + v[1] * v[2])
+                    / 6.0
+            };
+            let uu = second(&|(u, _)| u);
+            let vv = second(&|(_, v)| v);
+            // The mixed moment by polarisation: u v = ((u + v)^2 - u^2 - v^2) / 2.
+            let uv = 0.5 * (second(&|(u, v)| u + v) - uu - vv);
+            sums[0] += area;
+            sums[1] += area * (s[0].0 + s[1].0 + s[2].0) / 3.0;
+            sums[2] += area * (s[0].1 + s[1].1 + s[2].1) / 3.0;
+            sums[3] += area * uu;
+            sums[4] += area * vv;
+            sums[5] += area * uv;
+        }
+        let a = sums[0].max(f64::MIN_POSITIVE);
+        let (mu, mv) = (sums[1] / a, sums[2] / a);
+        SlopeVariances {
+            along: sums[3] / a - mu * mu,
+            across: sums[4] / a - mv * mv,
+            covariance: sums[5] / a - mu * mv,
+        }
     }
 }
 
@@ -168,6 +296,46 @@ mod tests {
         let rms = (sum_sq / n as f64).sqrt();
         // 400 samples of a sum of 24 sinusoids: the estimate is within ~20 % of the target.
         assert!((rms - 0.05).abs() < 0.01, "rms slope {rms}");
+    }
+
+    /// The mesh's area-weighted slope variances against the exact ones of a single ripple
+    /// at 30 degrees from z, meshed finely (25 vertices per wavelength along each axis) and
+    /// unfiltered over a whole number of wavelengths: along z, across (x) and their
+    /// covariance. A missing projection or a swapped axis would be off by a factor of 3.
+    #[test]
+    fn mesh_slope_variances_match_the_ripple() {
+        let (k, angle) = (std::f64::consts::TAU / 0.5, 30f64.to_radians());
+        let field = RippleField::from_ripples(vec![Ripple {
+            k: [k * angle.sin(), k * angle.cos()],
+            amplitude: 0.004,
+            phase: 0.3,
+        }]);
+        // 20 m along z and 20 m across: whole numbers of the ripple's periods along both.
+        let rows: Vec<GridRow> = (0..=2000)
+            .map(|j| GridRow {
+                z: -(j as f64) * 0.01,
+                dz: 0.01,
+                half_width: 10.0,
+            })
+            .collect();
+        let mesh = mesh_rows(&field, &rows, 2000, 0.0);
+        let exact = field.slope_variances([0.0, -1.0]);
+        let measured = mesh.slope_variances([0.0, -1.0], |_| true);
+        let s2 = 0.5 * (0.004 * k).powi(2);
+        // Along -z: cos^2 30 of the slope variance; across (+x): sin^2 30.
+        assert!((exact.along / (s2 * 0.75) - 1.0).abs() < 1e-12);
+        assert!((exact.across / (s2 * 0.25) - 1.0).abs() < 1e-12);
+        for (m, e) in [
+            (measured.along, exact.along),
+            (measured.across, exact.across),
+            (measured.covariance, exact.covariance),
+        ] {
+            assert!(
+                (m - e).abs() < 0.01 * s2,
+                "mesh {measured:?}, exact {exact:?}"
+            );
+        }
+        assert!(exact.covariance.abs() > 0.4 * s2);
     }
 
     #[test]
