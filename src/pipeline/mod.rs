@@ -19,7 +19,8 @@ use std::time::Instant;
 pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
 pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
 pub use water_choice::{
-    fine_structure_correlation, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_CORRELATION,
+    fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_CORRELATION,
+    EXACT_MIN_EXPLAINED,
 };
 
 use crate::fitting::gloss::estimate_gloss;

@@ -2,7 +2,7 @@
 //! statistical model's, and the automatic choice between them (the water_choice module's
 //! doc).
 
-use super::water_choice::{fine_structure_correlation, SlopesUsed, WaterChoice, WaterModelUsed};
+use super::water_choice::{fine_structure, SlopesUsed, WaterChoice, WaterModelUsed};
 use super::{Found, GlossFit, JointSettings, Method, Run, EXACT_MIN_CORRELATION};
 use crate::fitting::gloss::GlossSearch;
 use crate::fitting::joint::JointOptions;
@@ -21,6 +21,7 @@ impl WaterModelUsed {
             chosen: "forced",
             fine_structure_correlation: None,
             threshold: EXACT_MIN_CORRELATION,
+            exact_explained: None,
             slopes: None,
         }
     }
@@ -52,7 +53,13 @@ impl Run<'_> {
             (WaterChoice::Statistical, method) => self.statistical(method, found, "forced", None),
             (WaterChoice::Exact, method) => {
                 self.exact(method, found)?;
-                Ok(WaterModelUsed::forced("exact"))
+                // Measured all the same, for the report.
+                let fine = fine_structure(&self.photo.radiance, self.photo.width, &found.modelled);
+                Ok(WaterModelUsed {
+                    fine_structure_correlation: fine.and_then(|f| f.correlation),
+                    exact_explained: fine.and_then(|f| f.explained),
+                    ..WaterModelUsed::forced("exact")
+                })
             }
             // The paper's per-streak estimate has no expected image to compare.
             (WaterChoice::Auto, method @ Method::Paper) => {
@@ -79,13 +86,10 @@ impl Run<'_> {
                     },
                     found,
                 )?;
-                let correlation = fine_structure_correlation(
-                    &self.photo.radiance,
-                    self.photo.width,
-                    &found.modelled,
-                );
-                let exact = correlation.is_none_or(|c| c >= EXACT_MIN_CORRELATION);
-                if exact {
+                let fine = fine_structure(&self.photo.radiance, self.photo.width, &found.modelled);
+                let correlation = fine.and_then(|f| f.correlation);
+                let exact_explained = fine.and_then(|f| f.explained);
+                if fine.is_none_or(|f| f.exact_fits()) {
                     if matches!(j.gloss, GlossFit::Estimate(_)) {
                         found.warnings.truncate(warnings);
                         self.with_gloss_search(j, found)?;
@@ -93,6 +97,7 @@ impl Run<'_> {
                     return Ok(WaterModelUsed {
                         chosen: "detected",
                         fine_structure_correlation: correlation,
+                        exact_explained,
                         ..WaterModelUsed::forced("exact")
                     });
                 }
@@ -105,7 +110,9 @@ impl Run<'_> {
                 found.lights.clear();
                 found.uncertainties.clear();
                 found.skipped.clear();
-                self.statistical(method, found, "detected", correlation)
+                let mut used = self.statistical(method, found, "detected", correlation)?;
+                used.exact_explained = exact_explained;
+                Ok(used)
             }
         }
     }
@@ -240,6 +247,7 @@ impl Run<'_> {
             chosen,
             fine_structure_correlation: correlation,
             threshold: EXACT_MIN_CORRELATION,
+            exact_explained: None,
             slopes: Some(slopes),
         })
     }
