@@ -205,8 +205,8 @@ pub fn convert_loaded(
     let photo = timed(&mut before, progress, "load photo", || {
         photo_in::load(&options.photo, options.exposure)
     })?;
-    check_photo(&scene, &photo, &options.photo)?;
-    let mut lit = pipeline::fit(&scene, &photo, &options.fit, progress)?;
+    check_photo(scene, &photo, &options.photo)?;
+    let mut lit = pipeline::fit(scene, &photo, &options.fit, progress)?;
     let word = |text: &str| reword(text, options.wording);
     if let Some((about, why)) = &lit.nothing_found {
         let message = format!(
@@ -243,7 +243,7 @@ pub fn convert_loaded(
         .lights
         .iter()
         .enumerate()
-        .map(|(i, l)| light_to_write(&scene, l, light_name(i)))
+        .map(|(i, l)| light_to_write(scene, l, light_name(i)))
         .collect();
     let summary = timed(&mut after, progress, "write scene", || {
         scene_out::write_lit_scene(

@@ -161,7 +161,7 @@ pub(super) fn trace_samples(
         .par_iter()
         .map(|&pixel| {
             let done = traced.fetch_add(1, Ordering::Relaxed) + 1;
-            if done % every == 0 || done == total {
+            if done.is_multiple_of(every) || done == total {
                 progress.advance(done, total);
             }
             let stream = JOINT_STREAM | (draw as u64) << 52 | (repeat as u64) << 32 | pixel as u64;
