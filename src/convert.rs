@@ -8,14 +8,14 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::fitting::FittedLight;
-use crate::photo_in::{self, Photo};
-use crate::pipeline::{self, light_name, FitSettings, Input, Lit};
+use crate::photo_in;
+use crate::pipeline::{self, light_name, FitSettings, Input};
 use crate::progress::Reporter;
 use crate::report::{self, Files, Report};
 use crate::scene_in::{self, AreaLight, LoadOptions, Scene};
 use crate::scene_out::{self, LightToWrite, WriteOptions};
 use crate::settings::{reword, Setting};
-use crate::{output_file, photo_out, render, streaks, Error, Result};
+use crate::{debug_pictures, output_file, Error, Result};
 
 pub use crate::pipeline::check_photo;
 
@@ -82,6 +82,8 @@ pub struct ConvertOutcome {
     pub report: Report,
     /// The fitted lights, in the scene frame of the loaded scene.
     pub lights: Vec<FittedLight>,
+    /// Every file written: the scene (and its `.bin`), the report, the debug pictures.
+    pub files_written: Vec<PathBuf>,
 }
 
 /// Runs a stage, timing it and telling the reporter as it starts.
@@ -98,8 +100,8 @@ fn timed<T>(
     out
 }
 
-/// Checks the output path before any work, so a long run does not end in a refusal.
-fn check_output(options: &ConvertOptions) -> Result<()> {
+/// Checks the output paths before any work, so a long run does not end in a refusal.
+pub fn check_output(options: &ConvertOptions) -> Result<()> {
     let ext = options
         .output
         .extension()
@@ -155,20 +157,56 @@ fn light_to_write(scene: &Scene, light: &FittedLight, name: String) -> LightToWr
     }
 }
 
-/// Runs the whole conversion.
+/// Runs the whole conversion. Once the output paths are checked, a refusal with
+/// [`ConvertOptions::report`] set writes a report that says why ([`refusing`]).
 pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     check_output(options)?;
-    options.fit.validate()?;
+    refusing(options, || {
+        options.fit.validate()?;
+        let mut before = Vec::new();
+        let scene = timed(&mut before, options.progress, "load scene", || {
+            scene_in::load(&options.scene, &options.load)
+        })?;
+        convert_loaded(&scene, before, options)
+    })
+}
+
+/// Runs `run`; when it fails and [`ConvertOptions::report`] is set, writes there a report of
+/// the refusal (the error's text and the files, [`report::Refusal`]) and returns the error.
+pub fn refusing<T>(options: &ConvertOptions, run: impl FnOnce() -> Result<T>) -> Result<T> {
+    let result = run();
+    if let (Err(e), Some(path)) = (&result, &options.report) {
+        let refusal = report::Refusal::new(
+            files(options, None),
+            reword(&e.to_string(), options.wording),
+        );
+        refusal.write(path)?;
+    }
+    result
+}
+
+fn files(options: &ConvertOptions, output: Option<&Path>) -> Files {
+    Files {
+        scene: options.scene.display().to_string(),
+        photo: options.photo.display().to_string(),
+        output: output.map(|o| o.display().to_string()),
+    }
+}
+
+/// The conversion of [`ConvertOptions::photo`] in `scene`, already loaded from
+/// [`ConvertOptions::scene`] (`before`: the seconds that took, for the report's timings). The
+/// output paths must have been checked ([`check_output`]).
+pub fn convert_loaded(
+    scene: &Scene,
+    mut before: Vec<(String, f64)>,
+    options: &ConvertOptions,
+) -> Result<ConvertOutcome> {
     let progress = options.progress;
-    let mut before = Vec::new();
-    let scene = timed(&mut before, progress, "load scene", || {
-        scene_in::load(&options.scene, &options.load)
-    })?;
     let photo = timed(&mut before, progress, "load photo", || {
         photo_in::load(&options.photo, options.exposure)
     })?;
-    check_photo(&scene, &photo, &options.photo)?;
-    let mut lit = pipeline::fit(&scene, &photo, &options.fit, progress)?;
+    check_photo(scene, &photo, &options.photo)?;
+    let mut lit = pipeline::fit(scene, &photo, &options.fit, progress)?;
     let word = |text: &str| reword(text, options.wording);
     if let Some((about, why)) = &lit.nothing_found {
         let message = format!(
@@ -205,7 +243,7 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         .lights
         .iter()
         .enumerate()
-        .map(|(i, l)| light_to_write(&scene, l, light_name(i)))
+        .map(|(i, l)| light_to_write(scene, l, light_name(i)))
         .collect();
     let summary = timed(&mut after, progress, "write scene", || {
         scene_out::write_lit_scene(
@@ -218,20 +256,16 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             },
         )
     })?;
-    if let Some(dir) = &options.debug_dir {
-        timed(&mut after, progress, "debug pictures", || {
-            write_debug(dir, &scene, &photo, &lit, options)
-        })?;
+    let mut files_written = vec![options.output.clone()];
+    let bin = options.output.with_extension("streaklight.bin");
+    if bin.is_file() && options.output.extension().is_some_and(|e| e != "glb") {
+        files_written.push(bin);
     }
     let mut report = report::build(
-        &scene,
+        scene,
         &lit,
         report::Run {
-            files: Files {
-                scene: options.scene.display().to_string(),
-                photo: options.photo.display().to_string(),
-                output: Some(options.output.display().to_string()),
-            },
+            files: files(options, Some(&options.output)),
             settings: &options.fit,
             exposure: options.exposure,
             nits_scale: options.load.nits_scale,
@@ -243,81 +277,28 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
         r.light_index = summary.light_indices.get(k).copied();
         r.node_index = summary.node_indices.get(k).copied();
     }
+    if let Some(dir) = &options.debug_dir {
+        // After the report is built: the pictures' index shows its numbers.
+        progress.stage("debug pictures");
+        let start = Instant::now();
+        let pictures = debug_pictures::write(dir, scene, &photo, &lit, &report, options)?;
+        report.timings.push(report::Timing {
+            stage: "debug pictures".into(),
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        files_written.extend(pictures);
+    }
     if let Some(path) = &options.report {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| Error::output(path, e.to_string()))?;
         output_file::write_atomically(path, text.as_bytes())?;
+        files_written.push(path.clone());
     }
     Ok(ConvertOutcome {
         report,
         lights: lit.lights,
+        files_written,
     })
-}
-
-/// Writes the `segment` pictures and, side by side, the photo, the water re-rendered with the
-/// fitted lights, and their difference.
-fn write_debug(
-    dir: &Path,
-    scene: &Scene,
-    photo: &Photo,
-    lit: &Lit,
-    options: &ConvertOptions,
-) -> Result<()> {
-    let water = &lit.water;
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    streaks::pictures::write_pictures(dir, photo, water, &lit.segmentation)?;
-    streaks::report::write_report(
-        &dir.join("streaks.json"),
-        &lit.segmentation,
-        &options.fit.streaks,
-    )?;
-    let area: Vec<AreaLight> = lit
-        .lights
-        .iter()
-        .enumerate()
-        .map(|(i, l)| area_light(l, light_name(i)))
-        .collect();
-    let rendered = render::render_with_lights(
-        scene,
-        &area,
-        &render::RenderOptions {
-            width: photo.width,
-            height: photo.height,
-            samples_per_pixel: 64,
-            exposure: options.exposure,
-            seed: options.fit.seed,
-            shadowing: options.fit.shadowing,
-            progress: Reporter::default(),
-        },
-    )?;
-    let (w, h) = (photo.width as usize, photo.height as usize);
-    let mut side_by_side = vec![[0f32; 3]; 3 * w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            // Only the water is modelled; elsewhere the re-render is black by design.
-            let photo_value = photo.radiance[i].map(|c| c * options.exposure);
-            let model = if water[i] {
-                rendered.pixels[i]
-            } else {
-                [0.0; 3]
-            };
-            let diff = if water[i] {
-                [0, 1, 2].map(|c| (photo_value[c] - model[c]).abs())
-            } else {
-                [0.0; 3]
-            };
-            side_by_side[y * 3 * w + x] = photo_value;
-            side_by_side[y * 3 * w + w + x] = model;
-            side_by_side[y * 3 * w + 2 * w + x] = diff;
-        }
-    }
-    photo_out::write(
-        &dir.join("fit-photo-render-difference.png"),
-        3 * photo.width,
-        photo.height,
-        &side_by_side,
-    )
 }
 
 /// The world-space corner of a light for messages.

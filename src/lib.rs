@@ -13,7 +13,8 @@
 //! | 7-9. light plane, radiance, edges; the joint fit; the gloss | [`fitting`] |
 //! | the whole fit in memory, with its policies | [`pipeline`], [`settings`], [`progress`] |
 //! | 10. write the lights back | [`scene_out`] |
-//! | files in, files out; the report | [`convert`], [`report`] |
+//! | files in, files out; the report | [`convert`], [`batch`], [`report`] |
+//! | pictures of every stage, and their page | [`debug_pictures`] |
 //! | rendering a lit scene (to make and check photos) | [`render`], [`photo_out`] |
 //! | sample scenes of the paper's setup | [`samples`] |
 //!
@@ -50,7 +51,9 @@
 //! # }
 //! ```
 
+pub mod batch;
 pub mod convert;
+pub mod debug_pictures;
 pub mod error;
 pub mod fitting;
 pub mod optics;

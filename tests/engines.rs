@@ -2,8 +2,8 @@
 //! `EXT_lights_area`) loads a lit scene in headless Chromium; `tests/engines/babylon_check.mjs`
 //! checks the lights it created against the report, and this test checks its screenshots.
 //!
-//! Needs Node, `npm ci --prefix tests/engines` and Debian's Chromium
-//! (`apt-get install -y chromium`); without them the test fails and says so.
+//! Needs Node, `npm ci --prefix tests/engines` and Debian's Chromium, which `scripts/test`
+//! installs; without them the test fails and says so.
 //!
 //! The lit scene and its report are made here from the paper's Table 3 lights with
 //! `write_lit_scene`, in the shape `streaklight fit --report` writes. To check a real fit
@@ -12,16 +12,13 @@
 
 mod common;
 
+use common::node::run_node;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::Mutex;
 use std::time::Instant;
 
 use streaklight::samples;
-
-const ENGINES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/engines");
-const INSTALL: &str =
-    "install Node.js, run `npm ci --prefix tests/engines` and `apt-get install -y chromium`";
 
 /// One headless Chromium at a time: two software-rendering browsers on a 2-core machine
 /// would each take twice as long.
@@ -48,27 +45,6 @@ fn lit_scene_and_report(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     let outcome = streaklight::convert::convert(&options).expect("fitting the Table 3 sample");
     assert_eq!(outcome.report.lights.len(), 2, "Table 3 has two lights");
     (input, output, report)
-}
-
-/// Runs `node tests/engines/SCRIPT ARGS...`; panics with its output unless it succeeds.
-fn run_node(script: &str, args: &[(&str, &Path)], dir: &Path) {
-    let mut command = Command::new("node");
-    command.arg(Path::new(ENGINES_DIR).join(script));
-    for (flag, value) in args {
-        command.arg(flag).arg(value);
-    }
-    let run = command
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run `node` ({e}): {INSTALL}"));
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    println!("{stdout}{stderr}");
-    assert!(
-        run.status.success(),
-        "{script} failed ({}); files in {}:\n{stdout}{stderr}\n(if something is missing: {INSTALL})",
-        run.status,
-        dir.display()
-    );
 }
 
 /// Mean of (r + g + b) / 3 over the pixels where `mask` is set, in 8-bit units.

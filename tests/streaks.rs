@@ -326,8 +326,10 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
     assert!(ok, "{stderr}");
     assert!(stdout.contains("streak 1:"), "{stdout}");
     for name in ["superpixels.png", "seeds.png", "streaks.png", "edges.png"] {
+        // The photo's size, under a title and a key.
         let img = image::open(out.join(name)).unwrap();
-        assert_eq!((img.width(), img.height()), (600, 600));
+        assert_eq!(img.width(), 600);
+        assert!(img.height() > 600, "{name}: {}", img.height());
     }
     let report = read_json(&out.join("streaks.json"));
     let validator = schema_validator("streaks.schema.json");

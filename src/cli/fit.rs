@@ -1,38 +1,79 @@
-//! `streaklight fit SCENE PHOTO -o OUT`: the main job.
+//! `streaklight fit SCENE PHOTO -o OUT` (or `fit SCENE PHOTO... --out-dir DIR`): the main
+//! job.
 
 use std::path::PathBuf;
 
-use streaklight::convert::{convert, ConvertOptions};
+use streaklight::batch::convert_all;
+use streaklight::convert::ConvertOptions;
 use streaklight::pipeline::{FitSettings, JointSettings, Method, WaterChoice};
-use streaklight::progress::Reporter;
 
+use super::exit::{exit_codes, Exit};
+use super::fit_batch::{jobs, Outputs};
+use super::json::Summary;
+use super::output::Output;
 use super::scene_args::SceneArgs;
 use super::streak_args::StreakArgs;
+
+/// `fit --help`'s epilogue.
+pub const AFTER_HELP: &str = concat!(
+    "Examples:\n  \
+     streaklight fit samples/scene.gltf samples/table3.png --exposure 0.1 -o lit.gltf --report report.json\n  \
+     streaklight fit scene.glb photo.jpg --exposure 0.05 --gloss auto -o lit.glb --debug-dir debug\n  \
+     streaklight fit scene.gltf night1.png night2.png night3.png --exposure 0.1 --out-dir lit --json\n\n\
+     Typical values: --exposure 0.01-1 (the samples: 0.1); --gloss 100-2000 (rough to calm water; \
+     the samples: 500); --ior 1.33 (water); lights come out in metres (scene units) and radiance \
+     in the photo's linear units divided by the exposure.\n\n\
+     Pipelines: --json prints one summary object on stdout (schema/summary.schema.json); \
+     --report writes the full report (schema/report.schema.json), or, for a refused run, \
+     a report saying why.\n\n",
+    exit_codes!()
+);
 
 /// Arguments of `streaklight fit`.
 #[derive(clap::Args)]
 pub struct Args {
     /// The glTF scene (.gltf or .glb): a camera, the water, and the geometry lights hang on.
     pub scene: PathBuf,
-    /// The night photo of the water, taken from the scene's camera (PNG, JPEG, TIFF, EXR, HDR).
-    pub photo: PathBuf,
-    /// The lit scene to write: .gltf or .glb (never over an input).
-    #[arg(short, long)]
-    pub output: PathBuf,
-    /// Also write a JSON report of the lights, settings and timings here.
-    #[arg(long)]
+    /// The night photo(s) of the water, taken from the scene's camera (PNG, JPEG, TIFF, EXR,
+    /// HDR). Several photos need --out-dir; the scene is loaded once for all of them.
+    #[arg(required = true, value_name = "PHOTO")]
+    pub photos: Vec<PathBuf>,
+    /// The lit scene to write: .gltf or .glb (never over an input). One photo only.
+    #[arg(
+        short,
+        long,
+        conflicts_with = "out_dir",
+        required_unless_present = "out_dir"
+    )]
+    pub output: Option<PathBuf>,
+    /// Write each photo's lit scene and report into this folder, as NAME.gltf and
+    /// NAME.report.json (NAME: the photo's file name without its extension, with its position
+    /// added when two photos share a name).
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
+    /// With --out-dir: write .glb files instead of .gltf.
+    #[arg(long, requires = "out_dir")]
+    pub glb: bool,
+    /// Also write a JSON report of the lights, settings and timings here (with -o); a refused
+    /// run writes a report saying why.
+    #[arg(long, conflicts_with = "out_dir")]
     pub report: Option<PathBuf>,
-    /// Write pictures of every stage into this folder (superpixels, seeds, streaks, edges, and
-    /// the photo beside the water re-rendered with the fitted lights).
+    /// Write pictures of every stage into this folder, with an index.html showing them beside
+    /// the report's numbers (with --out-dir: one subfolder per photo).
     #[arg(long)]
     pub debug_dir: Option<PathBuf>,
+    /// Print one JSON summary object on stdout: the exit status, the lights, the warnings and
+    /// the files written (schema/summary.schema.json).
+    #[arg(long)]
+    pub json: bool,
     /// Blinn-Phong gloss e of the water, overriding its material's roughness; or "auto" to
     /// estimate it from the photo together with the lights (starting from the material's;
     /// several joint fits, so a few times slower). Not with --method paper.
     #[arg(long, value_name = "E|auto")]
     pub gloss: Option<GlossArg>,
-    /// The photo's exposure: its linear values are divided by it to give radiance.
-    #[arg(long, default_value_t = 1.0)]
+    /// The photo's exposure, > 0: its linear values are divided by it to give radiance (the
+    /// samples: 0.1).
+    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive_f32)]
     pub exposure: f32,
     /// Lobe samples per traced pixel.
     #[arg(long, default_value_t = streaklight::fitting::DEFAULT_SAMPLES)]
@@ -124,16 +165,38 @@ impl Args {
     }
 }
 
-/// Runs the command.
-pub fn run(args: Args) -> streaklight::Result<()> {
-    let terminal = super::progress::Terminal::new();
-    let options = ConvertOptions {
+/// Runs the command: fits every photo, tells what was done on stderr (and with `--json` on
+/// stdout), and returns the worst photo's exit.
+pub fn run(args: Args, out: &Output) -> Exit {
+    let mut summary = Summary::new();
+    if let Err(e) = fit_all(&args, out, &mut summary) {
+        let text = super::flags::in_flags(&e.to_string());
+        eprintln!("error: {text}");
+        summary.stopped(text, Exit::of_error(&e));
+    }
+    out.done();
+    if args.json {
+        summary.print();
+    }
+    summary.exit()
+}
+
+fn fit_all(args: &Args, out: &Output, summary: &mut Summary) -> streaklight::Result<()> {
+    let jobs = jobs(
+        &args.photos,
+        &Outputs {
+            output: args.output.as_deref(),
+            out_dir: args.out_dir.as_deref(),
+            report: args.report.as_deref(),
+            debug_dir: args.debug_dir.as_deref(),
+            glb: args.glb,
+        },
+    )?;
+    if let Some(dir) = &args.out_dir {
+        std::fs::create_dir_all(dir).map_err(|e| streaklight::Error::io(dir, e))?;
+    }
+    let template = ConvertOptions {
         fit: args.fit_settings()?,
-        scene: args.scene,
-        photo: args.photo,
-        output: args.output,
-        report: args.report,
-        debug_dir: args.debug_dir,
         load: args.scene_options.load_options(match args.gloss {
             Some(GlossArg::Value(e)) => Some(e),
             _ => None,
@@ -141,16 +204,54 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         exposure: args.exposure,
         fallback_quads: !args.no_fallback_quads,
         allow_empty: args.allow_empty,
-        progress: Reporter::new(&terminal),
+        progress: out.progress(),
         wording: super::flags::flag,
+        ..ConvertOptions::new(&args.scene, "", "")
     };
-    let outcome = convert(&options)?;
+    let results = convert_all(&template, &jobs)?;
+    for (job, result) in jobs.iter().zip(results) {
+        let photo = job.photo.display().to_string();
+        match result {
+            Ok(outcome) => {
+                tell(out, &outcome, &job.output, jobs.len() > 1, &photo);
+                summary.add(&photo, &outcome, &job.output.display().to_string());
+            }
+            Err(e) => {
+                let text = super::flags::in_flags(&e.to_string());
+                out.done();
+                eprintln!("error: {text}");
+                let report = job
+                    .report
+                    .as_ref()
+                    .filter(|r| r.is_file())
+                    .map(|r| r.display().to_string());
+                summary.refused(&photo, text, Exit::of_error(&e), report);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Tells on stderr what one photo's fit found and wrote.
+fn tell(
+    out: &Output,
+    outcome: &streaklight::convert::ConvertOutcome,
+    output: &std::path::Path,
+    batch: bool,
+    photo: &str,
+) {
+    out.done();
+    let prefix = if batch {
+        format!("{photo}: ")
+    } else {
+        String::new()
+    };
     for w in &outcome.report.warnings {
-        eprintln!("warning: {w}");
+        out.warn(&format!("{prefix}{w}"));
     }
     for light in &outcome.report.lights {
-        eprintln!(
-            "{}: streak(s) {:?}, corner ({:.4}, {:.4}, {:.4}), {:.4} x {:.4} m, radiance ({:.4}, {:.4}, {:.4})",
+        out.info(&format!(
+            "{prefix}{}: streak(s) {:?}, corner ({:.4}, {:.4}, {:.4}) m, {:.4} x {:.4} m, radiance ({:.4}, {:.4}, {:.4})",
             light.name,
             light.streak_ids,
             light.corner_left_bottom[0],
@@ -161,16 +262,15 @@ pub fn run(args: Args) -> streaklight::Result<()> {
             light.radiance[0],
             light.radiance[1],
             light.radiance[2]
-        );
+        ));
     }
     let total: f64 = outcome.report.timings.iter().map(|t| t.seconds).sum();
-    eprintln!(
-        "wrote {} with {} light(s) in {:.2} s",
-        options.output.display(),
+    out.info(&format!(
+        "{prefix}wrote {} with {} light(s) in {:.2} s",
+        output.display(),
         outcome.report.lights.len(),
         total
-    );
-    Ok(())
+    ));
 }
 
 /// `--gloss`: a value, or "auto".
@@ -189,8 +289,12 @@ impl std::str::FromStr for GlossArg {
         if s.eq_ignore_ascii_case("auto") {
             return Ok(GlossArg::Auto);
         }
-        s.parse::<f32>().map(GlossArg::Value).map_err(|_| {
-            format!("expected a number (the Blinn-Phong exponent e) or \"auto\", got \"{s}\"")
-        })
+        match s.parse::<f32>() {
+            Ok(e) if e.is_finite() && e > 0.0 => Ok(GlossArg::Value(e)),
+            _ => Err(format!(
+                "expected a number greater than 0 (the Blinn-Phong exponent e; calm water \
+                 1000-2000, rippled 100-500) or \"auto\", got \"{s}\""
+            )),
+        }
     }
 }

@@ -1,10 +1,16 @@
 //! One file per subcommand: its arguments and a `run` that calls the library.
 
+pub mod completions;
+pub mod exit;
 pub mod fit;
+pub mod fit_batch;
 pub mod flags;
+pub mod json;
+pub mod output;
 pub mod progress;
 pub mod render;
 pub mod samples;
 pub mod scene_args;
 pub mod segment;
 pub mod streak_args;
+pub mod values;

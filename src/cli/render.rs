@@ -2,11 +2,11 @@
 
 use std::path::PathBuf;
 
-use streaklight::progress::{Progress, Reporter};
 use streaklight::render::{render, RenderOptions};
 use streaklight::scene_in;
 use streaklight::{output_file, photo_out};
 
+use super::output::Output;
 use super::scene_args::SceneArgs;
 
 /// Arguments of `streaklight render`.
@@ -26,14 +26,15 @@ pub struct Args {
     /// Camera rays per pixel.
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
-    /// Multiplies radiance before it is stored.
-    #[arg(long, default_value_t = 1.0)]
+    /// Multiplies radiance before it is stored (> 0; the samples use 0.1).
+    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive_f32)]
     pub exposure: f32,
     /// Seed of every random number: the same seed gives the same image.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Blinn-Phong gloss e of the water, overriding its material's roughness.
-    #[arg(long)]
+    /// Blinn-Phong gloss e of the water, overriding its material's roughness (> 0; the
+    /// samples: 200-1000).
+    #[arg(long, value_parser = super::values::positive_f32)]
     pub gloss: Option<f32>,
     /// Camera, water and units.
     #[command(flatten)]
@@ -41,7 +42,7 @@ pub struct Args {
 }
 
 /// Runs the command.
-pub fn run(args: Args) -> streaklight::Result<()> {
+pub fn run(args: Args, out: &Output) -> streaklight::Result<()> {
     photo_out::ImageFormat::from_path(&args.output)?;
     output_file::ensure_not_an_input(&args.output, &[&args.scene])?;
     // Before the render, not after it: a folder that cannot take the image fails at once.
@@ -49,20 +50,19 @@ pub fn run(args: Args) -> streaklight::Result<()> {
     output_file::ensure_writable(&args.output)?;
     let scene = scene_in::load(&args.scene, &args.scene_options.load_options(args.gloss))?;
     for w in &scene.warnings {
-        eprintln!("warning: {w}");
+        out.warn(w);
     }
     if scene.area_lights.is_empty() {
-        eprintln!(
-            "warning: {} has no EXT_lights_area lights: the image will be black",
+        out.warn(&format!(
+            "{} has no EXT_lights_area lights: the image will be black",
             args.scene.display()
-        );
+        ));
     }
     let height = args.height.unwrap_or_else(|| {
         let aspect = scene.camera.aspect_ratio.unwrap_or(1.0);
         ((args.width as f32 / aspect).round() as u32).max(1)
     });
-    let terminal = super::progress::Terminal::new();
-    terminal.stage("rendering");
+    out.progress().stage("rendering");
     let options = RenderOptions {
         width: args.width,
         height,
@@ -70,11 +70,11 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         exposure: args.exposure,
         seed: args.seed,
         shadowing: args.scene_options.shadowing(),
-        progress: Reporter::new(&terminal),
+        progress: out.progress(),
     };
     let image = render(&scene, &options)?;
     photo_out::write(&args.output, image.width, image.height, &image.pixels)?;
-    eprintln!(
+    out.info(&format!(
         "wrote {} ({} x {}, {} spp) in {:.2} s: {:.2} M reflected rays/s",
         args.output.display(),
         image.width,
@@ -82,6 +82,6 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         args.spp,
         image.seconds,
         image.reflected_rays as f64 / image.seconds.max(1e-9) / 1e6
-    );
+    ));
     Ok(())
 }

@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use streaklight::progress::Reporter;
 use streaklight::samples;
 
 /// Arguments of `streaklight samples`.
@@ -24,16 +23,13 @@ pub struct Args {
 }
 
 /// Runs the command.
-pub fn run(args: Args) -> streaklight::Result<()> {
+pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
     for path in samples::write_scenes(&args.dir)? {
-        eprintln!("wrote {}", path.display());
+        out.info(&format!("wrote {}", path.display()));
     }
     if !args.scenes_only {
-        let terminal = super::progress::Terminal::new();
-        for path in
-            samples::render_photos(&args.dir, args.spp, &args.photos, Reporter::new(&terminal))?
-        {
-            eprintln!("wrote {}", path.display());
+        for path in samples::render_photos(&args.dir, args.spp, &args.photos, out.progress())? {
+            out.info(&format!("wrote {}", path.display()));
         }
     }
     Ok(())

@@ -18,8 +18,8 @@ pub struct Args {
     /// Folder for the pictures and streaks.json (created if missing).
     #[arg(long)]
     pub out_dir: PathBuf,
-    /// Divides the photo's linear values to give radiance.
-    #[arg(long, default_value_t = 1.0)]
+    /// Divides the photo's linear values to give radiance (> 0; the samples use 0.1).
+    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive_f32)]
     pub exposure: f32,
     /// Camera node or camera name (default: the first camera of the default scene).
     #[arg(long)]
@@ -33,7 +33,7 @@ pub struct Args {
 }
 
 /// Runs the command.
-pub fn run(args: Args) -> streaklight::Result<()> {
+pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
     let params = args.streak.params()?;
 
     let photo = photo_in::load(&args.photo, args.exposure)?;
@@ -46,7 +46,7 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         },
     )?;
     for w in &scene.warnings {
-        eprintln!("warning: {w}");
+        out.warn(w);
     }
     streaklight::convert::check_photo(&scene, &photo, &args.photo)?;
     let water = water_mask::water_mask(&scene, photo.width, photo.height);

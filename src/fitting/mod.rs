@@ -163,6 +163,9 @@ pub enum EdgeStatus {
     Unconstrained {
         /// Why, for a person.
         reason: String,
+        /// Streak-edge pixels the edge was estimated from anyway (they may not show the real
+        /// edge, `reason` says why); 0 when none was.
+        pixels: usize,
         /// No pixel of the streak's edge looks at this edge at all (rather than a few, or
         /// ones cut by the photo's border): it was placed at the lobes' farthest reach, and
         /// the joint refinement keeps it there instead of letting it trade against the

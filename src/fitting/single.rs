@@ -261,6 +261,7 @@ fn solve(
                         "only {valid} streak-edge pixels constrain the light's {} edge",
                         side.name()
                     ),
+                    pixels: valid,
                     unseen: valid == 0,
                 }
             } else if truncated as f32 > MAX_TRUNCATED_FRACTION * pixels.len() as f32 {
@@ -272,6 +273,7 @@ fn solve(
                         side.name(),
                         pixels.len()
                     ),
+                    pixels: valid,
                     unseen: false,
                 }
             } else {

@@ -1,8 +1,8 @@
 //! How the report is built from a fit ([`crate::pipeline::Lit`]) and the run's settings.
 
 use super::{
-    EdgeReport, EdgesReport, Files, LightReport, PlaneReport, Report, Settings, SkippedStreak,
-    Timing, UncertaintyReport, REPORT_VERSION,
+    light_warnings, EdgeReport, EdgesReport, Files, LightReport, PlaneReport, Report, Settings,
+    SkippedStreak, Timing, UncertaintyReport, REPORT_VERSION,
 };
 use crate::fitting::joint::{effective_samples, Uncertainty};
 use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, Skipped};
@@ -39,9 +39,15 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
         stage: stage.clone(),
         seconds: *seconds,
     };
-    Report {
+    let mut report = Report {
         report_version: REPORT_VERSION,
         tool_version: env!("CARGO_PKG_VERSION").into(),
+        status: if lit.lights.is_empty() {
+            super::NO_LIGHT_FOUND
+        } else {
+            super::LIGHTS_FOUND
+        }
+        .into(),
         files: run.files,
         settings: Settings {
             gloss: lit.gloss,
@@ -84,7 +90,10 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             .map(timing)
             .collect(),
         warnings: lit.warnings.clone(),
-    }
+    };
+    let light_warnings: Vec<String> = report.lights.iter().filter_map(light_warnings).collect();
+    report.warnings.extend(light_warnings);
+    report
 }
 
 fn edge_report(status: &EdgeStatus) -> EdgeReport {
@@ -94,21 +103,29 @@ fn edge_report(status: &EdgeStatus) -> EdgeReport {
             pixels: *pixels,
             reason: None,
         },
-        EdgeStatus::Unconstrained { reason, .. } => EdgeReport {
+        EdgeStatus::Unconstrained { reason, pixels, .. } => EdgeReport {
             status: "unconstrained".into(),
-            pixels: 0,
+            pixels: *pixels,
             reason: Some(reason.clone()),
         },
     }
 }
 
-fn uncertainty_report(u: &Uncertainty) -> Option<UncertaintyReport> {
+/// The uncertainties of `light`'s parameters. An edge the photo does not constrain has none,
+/// whatever the cost's curvature says there: its sigma would measure the noise about a
+/// position the photo does not show, not the error of the edge.
+fn uncertainty_report(light: &FittedLight, u: &Uncertainty) -> Option<UncertaintyReport> {
     // A light whose radiance cannot be told apart from another's has no finite uncertainty:
     // report none rather than a number a pipeline might trust.
     if !u.radiance.iter().all(|r| r.is_finite()) {
         return None;
     }
-    let e = |side: EdgeSide| u.edges[side].filter(|s| s.is_finite()).map(f64::from);
+    let e = |side: EdgeSide| {
+        u.edges[side]
+            .filter(|s| s.is_finite())
+            .filter(|_| matches!(light.edges[side], EdgeStatus::Constrained { .. }))
+            .map(f64::from)
+    };
     Some(UncertaintyReport {
         left: e(EdgeSide::Left),
         right: e(EdgeSide::Right),
@@ -150,7 +167,7 @@ pub fn light_report(
             bottom: edge_report(&light.edges[EdgeSide::Bottom]),
             top: edge_report(&light.edges[EdgeSide::Top]),
         },
-        uncertainty: uncertainty.and_then(uncertainty_report),
+        uncertainty: uncertainty.and_then(|u| uncertainty_report(light, u)),
         light_index: None,
         node_index: None,
     }

@@ -1,12 +1,22 @@
 //! The machine-readable report of a fit (`--report`), described by `schema/report.schema.json`.
 
 mod build;
+mod light_warnings;
+mod refusal;
 
 pub use build::{build, light_report, Run};
+pub use light_warnings::{light_warnings, LARGE_UNCERTAINTY};
+pub use refusal::Refusal;
 use serde::Serialize;
 
 /// Version of the report's shape; bumped when a field changes meaning.
-pub const REPORT_VERSION: u32 = 1;
+pub const REPORT_VERSION: u32 = 2;
+
+/// [`Report::status`] of a run that wrote lights.
+pub const LIGHTS_FOUND: &str = "lights found";
+/// [`Report::status`] of a run that found no light and wrote the scene unchanged (allowed
+/// empty).
+pub const NO_LIGHT_FOUND: &str = "no light found";
 
 /// Everything a pipeline needs to know about one run of `fit`.
 #[derive(Clone, Debug, Serialize)]
@@ -15,6 +25,8 @@ pub struct Report {
     pub report_version: u32,
     /// streaklight's version.
     pub tool_version: String,
+    /// [`LIGHTS_FOUND`] or [`NO_LIGHT_FOUND`] (a refused run's report is a [`Refusal`]).
+    pub status: String,
     /// The input scene, photo, and the output scene.
     pub files: Files,
     /// The model and sampling settings used.
@@ -114,7 +126,8 @@ pub struct LightReport {
 /// all lights' free edges and radiances (correlated errors included).
 #[derive(Clone, Debug, Serialize)]
 pub struct UncertaintyReport {
-    /// Left edge, metres (`None`: the photo does not constrain it).
+    /// Left edge, metres (`None`: the photo does not constrain it; always so for an edge
+    /// whose status is "unconstrained").
     pub left: Option<f64>,
     /// Right edge, metres.
     pub right: Option<f64>,
@@ -161,7 +174,8 @@ pub struct EdgeReport {
     /// touches the photo's border or the water's end, so the value is a guess; or the edge
     /// faces another light split from the same streak; `reason` says which).
     pub status: String,
-    /// Streak-edge pixels that constrained it.
+    /// Streak-edge pixels it was estimated from: those that constrained it, or for an
+    /// unconstrained edge those read anyway (which may not show the real edge; 0 if none).
     pub pixels: usize,
     /// Why it is unconstrained, if it is.
     pub reason: Option<String>,

@@ -6,12 +6,16 @@
 //! - `streaks.png`: each streak in its own colour over the darkened photo, with the water's
 //!   outline in blue and the brightest pixel as a white cross;
 //! - `edges.png`: streak edges by side: left red, right green, top blue, bottom yellow.
+//!
+//! Each is written under a title and a key of its colours, with every streak numbered as in
+//! `streaks.json` ([`crate::debug_pictures::canvas`]).
 
 use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
 
 use super::{Segmentation, StreakSide};
+use crate::debug_pictures::canvas::{label, with_header, Key};
 use crate::output_file::write_atomically;
 use crate::photo_in::Photo;
 use crate::{Error, Result};
@@ -149,7 +153,8 @@ pub fn edges_picture(photo: &Photo, seg: &Segmentation) -> RgbImage {
     img
 }
 
-fn write_png(path: &Path, img: &RgbImage) -> Result<()> {
+/// Writes `img` to `path` as PNG, atomically.
+pub fn write_png(path: &Path, img: &RgbImage) -> Result<()> {
     let mut bytes = Vec::new();
     img.write_to(
         &mut std::io::Cursor::new(&mut bytes),
@@ -159,6 +164,98 @@ fn write_png(path: &Path, img: &RgbImage) -> Result<()> {
     write_atomically(path, &bytes)
 }
 
+/// Numbers every streak ("S0", "S1", ... as in `streaks.json`) beside its brightest pixel.
+fn number_streaks(img: &mut RgbImage, seg: &Segmentation) {
+    for s in &seg.streaks {
+        let (x, y) = s.brightest;
+        label(
+            img,
+            x as i64 + 6,
+            y as i64 - 22,
+            &format!("S{}", s.id),
+            streak_colour(s.id),
+        );
+    }
+}
+
+/// The four pictures, titled, keyed and with the streaks numbered: (file name, picture).
+pub fn pictures(
+    photo: &Photo,
+    water: &[bool],
+    seg: &Segmentation,
+) -> Vec<(&'static str, RgbImage)> {
+    let mut streaks = streaks_picture(photo, water, seg);
+    number_streaks(&mut streaks, seg);
+    let mut edges = edges_picture(photo, seg);
+    number_streaks(&mut edges, seg);
+    let mut streak_keys: Vec<Key> = seg
+        .streaks
+        .iter()
+        .map(|s| {
+            Key::new(
+                streak_colour(s.id),
+                format!("S{}: {} px", s.id, s.pixels.len()),
+            )
+        })
+        .collect();
+    streak_keys.push(Key::new([40, 90, 255], "water's outline"));
+    streak_keys.push(Key::new([255, 255, 255], "+ brightest pixel"));
+    vec![
+        (
+            "superpixels.png",
+            with_header(
+                &superpixels_picture(photo, seg),
+                &format!(
+                    "Superpixels (SLIC): {} over the photo",
+                    seg.superpixels.count
+                ),
+                &[Key::new([255, 220, 0], "superpixel boundary")],
+            ),
+        ),
+        (
+            "seeds.png",
+            with_header(
+                &seeds_picture(photo, seg),
+                &format!(
+                    "Seeds: {} seed superpixels, {} seed points kept of {}",
+                    seg.seed_superpixels.len(),
+                    seg.seeds.len(),
+                    seg.seed_points.len()
+                ),
+                &[
+                    Key::new([0, 200, 255], "seed superpixel"),
+                    Key::new([255, 0, 0], "+ seed point"),
+                    Key::new([255, 0, 255], "+ dropped seed point"),
+                ],
+            ),
+        ),
+        (
+            "streaks.png",
+            with_header(
+                &streaks,
+                &format!(
+                    "Streaks: {} found, numbered as in streaks.json",
+                    seg.streaks.len()
+                ),
+                &streak_keys,
+            ),
+        ),
+        (
+            "edges.png",
+            with_header(
+                &edges,
+                "Streak edges by side (the pixels that place the lights' edges)",
+                &[
+                    Key::new([255, 40, 40], "left"),
+                    Key::new([40, 255, 40], "right"),
+                    Key::new([60, 60, 255], "top"),
+                    Key::new([255, 230, 0], "bottom"),
+                ],
+            ),
+        ),
+    ]
+}
+
 /// Writes the four pictures into `dir` and returns their paths.
 pub fn write_pictures(
     dir: &Path,
@@ -166,12 +263,7 @@ pub fn write_pictures(
     water: &[bool],
     seg: &Segmentation,
 ) -> Result<Vec<PathBuf>> {
-    let pictures = [
-        ("superpixels.png", superpixels_picture(photo, seg)),
-        ("seeds.png", seeds_picture(photo, seg)),
-        ("streaks.png", streaks_picture(photo, water, seg)),
-        ("edges.png", edges_picture(photo, seg)),
-    ];
+    let pictures = pictures(photo, water, seg);
     let mut paths = Vec::new();
     for (name, img) in &pictures {
         let path = dir.join(name);

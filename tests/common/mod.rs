@@ -20,6 +20,9 @@ pub mod pipeline;
 /// Running the command line.
 pub mod cli;
 
+/// Running the Node scripts of `tests/engines/`.
+pub mod node;
+
 /// Running code on a given number of threads.
 pub mod threads;
 

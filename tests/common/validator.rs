@@ -11,11 +11,11 @@ use serde_json::Value;
 pub fn validator_problems(file: &Path) -> BTreeMap<(String, String), usize> {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/validator/validate.mjs");
     let out = Command::new("node").arg(script).arg(file).output().unwrap_or_else(|e| {
-        panic!("cannot run `node` ({e}): install Node.js, then run `npm ci --prefix tests/validator`")
+        panic!("cannot run `node` ({e}): run `scripts/test`, which installs Node.js and runs `npm ci --prefix tests/validator`")
     });
     assert!(
         out.status.success(),
-        "glTF-Validator on {} failed ({}): {} -- if the package is missing, run `npm ci --prefix tests/validator`",
+        "glTF-Validator on {} failed ({}): {} -- if the package is missing, run `scripts/test` (it runs `npm ci --prefix tests/validator`)",
         file.display(),
         out.status,
         String::from_utf8_lossy(&out.stderr)

@@ -380,8 +380,9 @@ pub(super) fn search_start(
         .iter()
         .map(|l| FittedLight {
             edges: l.edges.clone().map(|e| match e {
-                EdgeStatus::Unconstrained { reason, .. } => EdgeStatus::Unconstrained {
+                EdgeStatus::Unconstrained { reason, pixels, .. } => EdgeStatus::Unconstrained {
                     reason,
+                    pixels,
                     unseen: false,
                 },
                 constrained => constrained,

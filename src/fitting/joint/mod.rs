@@ -315,6 +315,7 @@ pub fn fit_joint_with(
             repeat,
             draw,
             options.control_variate,
+            options.progress,
         )
     };
     let problem_for = |repeat: u32| {
@@ -340,8 +341,18 @@ pub fn fit_joint_with(
         // One plane in, one set out.
         stored.swap_remove(0)
     };
+    options.progress.stage(&format!(
+        "joint fit: tracing the footprints of {} pixels, {} samples each",
+        pixels.len(),
+        effective_samples(options.samples)
+    ));
     let mut problem = problem_for(0);
     let mut footprint_seconds = t0.elapsed().as_secs_f64();
+    options.progress.stage(&format!(
+        "joint fit: descent of {} light(s), {} sweeps",
+        start.len(),
+        options.sweeps
+    ));
     let t1 = Instant::now();
     let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
     let (first, replay) = optimise(
@@ -351,6 +362,7 @@ pub fn fit_joint_with(
         options.sweeps,
         options.split,
         &|origin, draw| fresh_set(0, origin, draw),
+        options.progress,
     );
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
@@ -425,6 +437,7 @@ pub fn fit_joint_with(
                 if facing[k][side] {
                     edges[side] = EdgeStatus::Unconstrained {
                         reason: FACING_REASON.into(),
+                        pixels: 0,
                         unseen: false,
                     };
                 }

@@ -16,6 +16,7 @@ use super::samples::{sample_extent, PlaneSamples};
 use super::split::try_split;
 use crate::fitting::rect::Rect;
 use crate::fitting::{EdgeStatus, FittedLight};
+use crate::progress::Reporter;
 
 /// Fits the lights from `start`: a descent, then a split of any light whose residual is
 /// structured (see [`try_split`]), the second light of each split given a sample set of its
@@ -23,7 +24,8 @@ use crate::fitting::{EdgeStatus, FittedLight};
 /// the boundary between the two placed by [`search_boundary`], and another descent. Returns
 /// the optimum and the state its last descent started from (the start, or the split lights
 /// after their boundary search): a repeat on other samples starts there (see
-/// [`Problem::replay`]).
+/// [`Problem::replay`]). `progress` hears each split (so that a fit announced with N lights
+/// that ends with more says why) and the count of boundary candidates descended.
 pub(super) fn optimise(
     problem: &mut Problem,
     start: &[FittedLight],
@@ -31,6 +33,7 @@ pub(super) fn optimise(
     sweeps: u32,
     split: bool,
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
+    progress: Reporter<'_>,
 ) -> (State, State) {
     let mut st = problem.state(
         (0..start.len()).collect(),
@@ -68,8 +71,16 @@ pub(super) fn optimise(
             let set = problem.add_set(samples, origin);
             problem.move_to_set(&mut st, b, set);
             let starts = search_boundary(problem, &st, k, b, inner);
+            progress.stage(&format!(
+                "joint fit: the residual of light {k} is structured, as where two lights' \
+                 reflections merge into one streak: split into lights {k} and {b}, their \
+                 boundary searched from {} candidates",
+                starts.len()
+            ));
+            let candidates = starts.len() as u64;
             let mut best: Option<(State, f64)> = None;
-            for mut cand in starts {
+            for (done, mut cand) in starts.into_iter().enumerate() {
+                progress.advance(done as u64, candidates);
                 problem.descend(&mut cand, extents, CANDIDATE_SWEEPS);
                 let c = problem.cost(&cand);
                 if best.as_ref().is_none_or(|(_, b)| c < *b) {
@@ -81,6 +92,10 @@ pub(super) fn optimise(
             }
         }
         if problem.planes.len() > start.len() {
+            progress.stage(&format!(
+                "joint fit: descent of the {} light(s) after the split",
+                st.rects.len()
+            ));
             replay = st.clone();
             problem.descend(&mut st, extents, sweeps);
         }

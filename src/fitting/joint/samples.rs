@@ -13,6 +13,8 @@
 //! random numbers across all parameter values, so the cost is a deterministic function of the
 //! rectangles.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -21,6 +23,7 @@ use super::kernel::{cell_half_extents, kernel_coverage, LobeNeighbours};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::optics::{compact_strata, ReflectionModel};
+use crate::progress::Reporter;
 use crate::random::Rng;
 use crate::scene_in::Scene;
 use crate::water_model::WaterModel;
@@ -128,6 +131,7 @@ fn lobe_strata(samples: u32) -> u32 {
 /// wherever the Gaussian is, or the estimate would see light through the obstacle.
 /// `repeat` and `draw` select independent random streams: `draw` 0 is the set every start
 /// light reads, `draw` 1, 2, ... the sets of lights that splits added (one plane each).
+/// `progress` hears the count of pixels traced.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn trace_samples(
     water_model: &dyn WaterModel,
@@ -143,13 +147,23 @@ pub(super) fn trace_samples(
     repeat: u32,
     draw: u32,
     gaussians: bool,
+    progress: Reporter<'_>,
 ) -> (Vec<PlaneSamples>, u32) {
     type Hits = (Vec<(u16, Vec2, Vec2, f32, f32)>, Vec<LobeGaussian>);
     let lobe = lobe_strata(samples);
     let per_pixel_samples = effective_samples(samples);
+    let total = pixels.len() as u64;
+    let traced = AtomicU64::new(0);
+    // About a hundred reports over the whole set.
+    let every = (total / 100).max(1);
+    progress.advance(0, total);
     let per_pixel: Vec<Hits> = pixels
         .par_iter()
         .map(|&pixel| {
+            let done = traced.fetch_add(1, Ordering::Relaxed) + 1;
+            if done.is_multiple_of(every) || done == total {
+                progress.advance(done, total);
+            }
             let stream = JOINT_STREAM | (draw as u64) << 52 | (repeat as u64) << 32 | pixel as u64;
             let mut rng = Rng::new(seed, stream);
             let (x, y) = (pixel % width, pixel / width);

@@ -215,9 +215,10 @@ pub(super) fn facing_edges(problem: &Problem, st: &State) -> Vec<[bool; 4]> {
 pub fn edge_statuses(light: &FittedLight, u: &Uncertainty) -> [EdgeStatus; 4] {
     let mut out = light.edges.clone();
     for side in EdgeSide::ALL {
-        if u.edges[side].is_none() && matches!(out[side], EdgeStatus::Constrained { .. }) {
+        if let (None, EdgeStatus::Constrained { pixels }) = (u.edges[side], &out[side]) {
             out[side] = EdgeStatus::Unconstrained {
                 reason: "moving this edge does not change the modelled photo".into(),
+                pixels: *pixels,
                 unseen: false,
             };
         }

@@ -1,0 +1,109 @@
+//! Several photos of one scene in one run: the scene (and its BVH) is loaded once, and each
+//! photo is fitted and written as [`crate::convert::convert`] would, to its own files.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::convert::{check_output, convert_loaded, refusing, ConvertOptions, ConvertOutcome};
+use crate::{output_file, scene_in, Error, Result};
+
+/// One photo of a batch and the files its fit writes.
+#[derive(Clone, Debug)]
+pub struct Job {
+    /// The photo.
+    pub photo: PathBuf,
+    /// The lit scene to write (`.gltf` or `.glb`).
+    pub output: PathBuf,
+    /// The report to write, if any.
+    pub report: Option<PathBuf>,
+    /// The folder of the debug pictures, if any.
+    pub debug_dir: Option<PathBuf>,
+}
+
+/// Fits every job's photo in the scene of `template` (whose photo, output, report and debug
+/// folder are replaced by each job's), loading the scene once. Returns each job's outcome in
+/// order: one photo's refusal does not stop the others, and a job with a report path writes
+/// its refusal there as [`convert`](crate::convert::convert) does.
+///
+/// Fails as a whole, before any work, when two jobs would write the same file or one would
+/// write over another's photo; and when the settings or the scene are refused (then every
+/// job's report says so).
+pub fn convert_all(template: &ConvertOptions, jobs: &[Job]) -> Result<Vec<Result<ConvertOutcome>>> {
+    check_distinct(jobs)?;
+    let photos: Vec<&Path> = jobs.iter().map(|j| j.photo.as_path()).collect();
+    let options: Vec<ConvertOptions> = jobs
+        .iter()
+        .map(|j| ConvertOptions {
+            photo: j.photo.clone(),
+            output: j.output.clone(),
+            report: j.report.clone(),
+            debug_dir: j.debug_dir.clone(),
+            ..template.clone()
+        })
+        .collect();
+    // Paths first, for every job: a long batch does not end in a refusal of its last output.
+    let checked: Vec<Result<()>> = options
+        .iter()
+        .map(|o| {
+            check_output(o)?;
+            output_file::ensure_not_an_input(&o.output, &photos)?;
+            o.report
+                .as_ref()
+                .map_or(Ok(()), |r| output_file::ensure_not_an_input(r, &photos))
+        })
+        .collect();
+    let progress = template.progress;
+    let start = Instant::now();
+    progress.stage("load scene");
+    let loaded = template
+        .fit
+        .validate()
+        .and_then(|()| scene_in::load(&template.scene, &template.load));
+    let seconds = start.elapsed().as_secs_f64();
+    let scene = match loaded {
+        Ok(scene) => scene,
+        Err(e) => {
+            let text = e.to_string();
+            for (o, c) in options.iter().zip(&checked) {
+                if c.is_ok() {
+                    // The same refusal in each report.
+                    let _ = refusing(o, || Err::<(), _>(Error::Usage(text.clone())));
+                }
+            }
+            return Err(e);
+        }
+    };
+    let n = jobs.len();
+    Ok(options
+        .iter()
+        .zip(checked)
+        .enumerate()
+        .map(|(i, (o, c))| {
+            c?;
+            progress.stage(&format!("photo {} of {n}: {}", i + 1, o.photo.display()));
+            refusing(o, || {
+                convert_loaded(&scene, vec![("load scene".into(), seconds)], o)
+            })
+        })
+        .collect())
+}
+
+/// Refuses jobs that would write the same file or folder twice.
+fn check_distinct(jobs: &[Job]) -> Result<()> {
+    let mut seen = HashSet::new();
+    for j in jobs {
+        let paths = std::iter::once(&j.output)
+            .chain(&j.report)
+            .chain(&j.debug_dir);
+        for p in paths {
+            if !seen.insert(p.clone()) {
+                return Err(Error::output(
+                    p,
+                    "two photos of the batch would write this same file; name their outputs apart",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
