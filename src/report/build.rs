@@ -151,6 +151,7 @@ pub fn light_report(
             top: edge_report(&light.edges[EdgeSide::Top]),
         },
         uncertainty: uncertainty.and_then(uncertainty_report),
+        direct_pixels: uncertainty.map(|u| u.direct_pixels),
         light_index: None,
         node_index: None,
     }

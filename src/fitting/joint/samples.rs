@@ -17,6 +17,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use super::control_variate::{self, LobeGaussian};
+use super::direct::{direct_hits, Hit, DIRECT_RAYS};
 use super::kernel::{cell_half_extents, kernel_coverage, LobeNeighbours};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
@@ -45,7 +46,8 @@ pub(super) struct PlaneSamples {
     /// [`cell_half_extents`] and [`super::kernel`]).
     pub(super) cells: Vec<Vec2>,
     /// Per sample, its weight less the control variate's (see [`super::control_variate`]):
-    /// negative where the Gaussian outweighs the lobe.
+    /// negative where the Gaussian outweighs the lobe. A direct pixel's samples (see
+    /// [`super::direct`]) weigh the pixel's sample count over its camera rays.
     pub(super) weights: Vec<f32>,
     /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1).
     pub(super) halves: Vec<f32>,
@@ -128,6 +130,8 @@ fn lobe_strata(samples: u32) -> u32 {
 /// wherever the Gaussian is, or the estimate would see light through the obstacle.
 /// `repeat` and `draw` select independent random streams: `draw` 0 is the set every start
 /// light reads, `draw` 1, 2, ... the sets of lights that splits added (one plane each).
+/// The pixels from `first_direct` on see the lights' walls directly: their samples are their
+/// camera rays ([`super::direct`]), without a control variate.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn trace_samples(
     water_model: &dyn WaterModel,
@@ -143,16 +147,23 @@ pub(super) fn trace_samples(
     repeat: u32,
     draw: u32,
     gaussians: bool,
+    first_direct: usize,
 ) -> (Vec<PlaneSamples>, u32) {
-    type Hits = (Vec<(u16, Vec2, Vec2, f32, f32)>, Vec<LobeGaussian>);
+    type Hits = (Vec<Hit>, Vec<LobeGaussian>);
     let lobe = lobe_strata(samples);
     let per_pixel_samples = effective_samples(samples);
+    let direct_weight = per_pixel_samples as f32 / DIRECT_RAYS as f32;
     let per_pixel: Vec<Hits> = pixels
         .par_iter()
-        .map(|&pixel| {
+        .enumerate()
+        .map(|(index, &pixel)| {
             let stream = JOINT_STREAM | (draw as u64) << 52 | (repeat as u64) << 32 | pixel as u64;
             let mut rng = Rng::new(seed, stream);
             let (x, y) = (pixel % width, pixel / width);
+            if index >= first_direct {
+                let hits = direct_hits(scene, planes, roi, x, y, width, height, &mut rng, direct_weight);
+                return (hits, vec![LobeGaussian::NONE; planes.len()]);
+            }
             let mut hits = Vec::new();
             let mut missed_water = 0u32;
             // The control variates, matched to the pixel's first camera ray to meet the water
@@ -314,7 +325,9 @@ pub(super) fn trace_samples(
                 out.bbox.push(bb);
                 out.offsets.push(out.points.len() as u32);
             }
-            out.min_size = smallest_light(&out.cells);
+            // From the water pixels' samples alone: the bound is about the lobes' kernels.
+            let lobe_samples = out.offsets[first_direct.min(pixels.len())] as usize;
+            out.min_size = smallest_light(&out.cells[..lobe_samples]);
             out
         })
         .collect();

@@ -15,6 +15,11 @@ pub struct Uncertainty {
     pub edges: [Option<f32>; 4],
     /// Radiance per channel, in radiance units.
     pub radiance: [f32; 3],
+    /// Fitted pixels outside the water that see the light itself (a sample of their camera
+    /// rays lands inside its rectangle): 0 for a light out of frame or hidden, or with the
+    /// direct view off. The edges they cross pin the rectangle to a fraction of a pixel
+    /// (their sigmas say how well).
+    pub direct_pixels: usize,
 }
 
 /// One-sigma uncertainties of every light's free edges and radiances, from their full
@@ -155,6 +160,7 @@ pub(super) fn uncertainties(
         .map(|_| Uncertainty {
             edges: [None; 4],
             radiance: [f32::INFINITY; 3],
+            direct_pixels: 0,
         })
         .collect();
     if let Some(cov) = covariance {
