@@ -45,8 +45,10 @@ pub(super) fn optimise(
         .map(|(k, (l, r))| {
             let direct = problem.direct_edge_pixels(k, r);
             EdgeSide::ALL.map(|side| {
-                matches!(l.edges[side], EdgeStatus::Unconstrained { unseen: true, .. })
-                    && direct[side] == 0
+                matches!(
+                    l.edges[side],
+                    EdgeStatus::Unconstrained { unseen: true, .. }
+                ) && direct[side] == 0
             })
         })
         .collect();

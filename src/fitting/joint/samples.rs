@@ -43,13 +43,15 @@ pub(super) struct PlaneSamples {
     /// Per sample, where it lands (plane coordinates).
     pub(super) points: Vec<Vec2>,
     /// Per sample, the half-widths of its kernel along the plane's axes (see
-    /// [`cell_half_extents`] and [`super::kernel`]).
+    /// [`cell_half_extents`] and [`super::kernel`]); negative for a direct pixel's sample,
+    /// whose kernel is the plain box of its stratum ([`super::direct`]).
     pub(super) cells: Vec<Vec2>,
     /// Per sample, its weight less the control variate's (see [`super::control_variate`]):
     /// negative where the Gaussian outweighs the lobe. A direct pixel's samples (see
-    /// [`super::direct`]) weigh the pixel's sample count over its camera rays.
+    /// [`super::direct`]) weigh the pixel's sample count over its strata.
     pub(super) weights: Vec<f32>,
-    /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1).
+    /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1); 0
+    /// for a direct pixel's samples, whose coefficient is exact (no noise to measure).
     pub(super) halves: Vec<f32>,
     /// Per pixel, the control variate ([`LobeGaussian::NONE`] without).
     pub(super) gauss: Vec<LobeGaussian>,
@@ -131,7 +133,7 @@ fn lobe_strata(samples: u32) -> u32 {
 /// `repeat` and `draw` select independent random streams: `draw` 0 is the set every start
 /// light reads, `draw` 1, 2, ... the sets of lights that splits added (one plane each).
 /// The pixels from `first_direct` on see the lights' walls directly: their samples are their
-/// camera rays ([`super::direct`]), without a control variate.
+/// strata's camera rays ([`super::direct`]), without a control variate.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn trace_samples(
     water_model: &dyn WaterModel,
@@ -161,7 +163,7 @@ pub(super) fn trace_samples(
             let mut rng = Rng::new(seed, stream);
             let (x, y) = (pixel % width, pixel / width);
             if index >= first_direct {
-                let hits = direct_hits(scene, planes, roi, x, y, width, height, &mut rng, direct_weight);
+                let hits = direct_hits(scene, planes, roi, x, y, width, height, direct_weight);
                 return (hits, vec![LobeGaussian::NONE; planes.len()]);
             }
             let mut hits = Vec::new();
@@ -320,7 +322,7 @@ pub(super) fn trace_samples(
                 let first = *out.offsets.last().unwrap_or(&0) as usize;
                 let mut bb = Rect::EMPTY;
                 for (p, h) in out.points[first..].iter().zip(&out.cells[first..]) {
-                    bb = bb.union(&Rect::around(*p, *h));
+                    bb = bb.union(&Rect::around(*p, h.abs()));
                 }
                 out.bbox.push(bb);
                 out.offsets.push(out.points.len() as u32);

@@ -24,14 +24,16 @@ pub struct Uncertainty {
 
 /// One-sigma uncertainties of every light's free edges and radiances, from their full
 /// covariance at once (Gauss-Newton, made robust to uneven noise: see below), J being the
-/// model's derivatives at every unclipped fitted pixel and channel. Holding the other
-/// parameters fixed, as a per-edge curvature would, understates errors that travel along
-/// correlated directions (a light's height against its radiance when only one end of its
-/// streak is seen); the full covariance carries them.
+/// model's derivatives at every fitted pixel that measures it and every channel. Holding the
+/// other parameters fixed, as a per-edge curvature would, understates errors that travel
+/// along correlated directions (a light's height against its radiance when only one end of
+/// its streak is seen); the full covariance carries them.
 ///
 /// An edge's derivative is the change of the coefficients over a step of 2 % of the light's
 /// size (at least 5 mm) each way: below a few millimetres the stored samples make the
-/// coefficients a staircase. An edge that moves nothing gets no uncertainty (`None`: the photo
+/// coefficients a staircase. A direct pixel's (`direct`) is taken over a quarter of its
+/// footprint, and only the pixels that measure the model count ([`Problem::measures`]: not
+/// clipped, and not black where the light is seen directly). An edge that moves nothing gets no uncertainty (`None`: the photo
 /// does not constrain it), and so does a pinned one.
 pub(super) fn uncertainties(
     problem: &Problem,
@@ -55,8 +57,20 @@ pub(super) fn uncertainties(
             }
             let e = r.edge(side);
             let set = st.set_of[k];
-            let (g, g_dev) =
+            let (mut g, mut g_dev) =
                 problem.edge_slopes(set, &r.with_edge(side, e + h), &r.with_edge(side, e - h), h);
+            // The direct pixels' coefficients are smooth on a far finer scale.
+            if let Some(hd) = problem.direct_step(set, side.along_u()) {
+                let (gd, gd_dev) = problem.edge_slopes(
+                    set,
+                    &r.with_edge(side, e + hd),
+                    &r.with_edge(side, e - hd),
+                    hd,
+                );
+                let direct = problem.first_direct..problem.n();
+                g[direct.clone()].copy_from_slice(&gd[direct.clone()]);
+                g_dev[direct.clone()].copy_from_slice(&gd_dev[direct]);
+            }
             if g.iter().any(|&x| x != 0.0) {
                 params.push(Param::Edge(k, side, g, g_dev));
             }
@@ -97,7 +111,7 @@ pub(super) fn uncertainties(
     let mut row = vec![0.0; p];
     let mut dev_row = vec![0.0; p];
     let mut score = vec![0.0; p];
-    for i in (0..problem.n()).filter(|&i| !problem.clipped[i]) {
+    for i in (0..problem.n()).filter(|&i| problem.measures(i)) {
         let m = problem.model(st, i);
         score.iter_mut().for_each(|x| *x = 0.0);
         let mut any = false;

@@ -34,48 +34,31 @@ fn wall() -> (Scene, Vec<bool>, LightPlane) {
 /// Where the corner (`x`, `y`) of the image lands on the plane.
 fn corner(scene: &Scene, plane: &LightPlane, x: f32, y: f32) -> Vec2 {
     let dir = scene.camera.direction(x, y, PHOTO_SIZE, PHOTO_SIZE);
-    plane.hit(scene.camera.position, dir).expect("on the wall").1
+    plane
+        .hit(scene.camera.position, dir)
+        .expect("on the wall")
+        .1
 }
 
-/// Mean, its standard error and one draw's standard deviation over `draws` independent draws of the direct coefficient of pixel
-/// (`x`, `y`) for `rect`, as the fit computes it (kernel coverage summed, over the rays).
-fn coefficient_draws(
-    scene: &Scene,
-    plane: &LightPlane,
-    rect: &Rect,
-    x: u32,
-    y: u32,
-    draws: u64,
-) -> (f64, f64, f64) {
+/// The direct coefficient of pixel (`x`, `y`) for `rect`, as the fit computes it (each
+/// sample's box share inside the rectangle, summed, over the strata).
+fn coefficient(scene: &Scene, plane: &LightPlane, rect: &Rect, x: u32, y: u32) -> f64 {
     let roi = rect.grow(0.5);
-    let mut values = Vec::new();
-    for seed in 0..draws {
-        let mut rng = Rng::new(seed, 77);
-        let hits = direct_hits(
-            scene,
-            &[plane],
-            &[roi],
-            x,
-            y,
-            PHOTO_SIZE,
-            PHOTO_SIZE,
-            &mut rng,
-            1.0,
-        );
-        let c: f32 = hits
-            .iter()
-            .map(|&(k, q, h, w, _)| {
-                assert_eq!(k, 0);
-                w * kernel_coverage(q.x, h.x, rect.u_min, rect.u_max)
-                    * kernel_coverage(q.y, h.y, rect.v_min, rect.v_max)
-            })
-            .sum();
-        values.push(c as f64 / DIRECT_RAYS as f64);
-    }
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt(), var.sqrt())
+    let hits = direct_hits(scene, &[plane], &[roi], x, y, PHOTO_SIZE, PHOTO_SIZE, 1.0);
+    assert_eq!(
+        hits.len(),
+        DIRECT_RAYS as usize,
+        "every stratum sees the wall"
+    );
+    let c: f32 = hits
+        .iter()
+        .map(|&(k, q, h, w, half)| {
+            assert_eq!((k, half), (0, 0.0));
+            w * kernel_coverage(q.x, h.x, rect.u_min, rect.u_max)
+                * kernel_coverage(q.y, h.y, rect.v_min, rect.v_max)
+        })
+        .sum();
+    c as f64 / DIRECT_RAYS as f64
 }
 
 #[test]
@@ -103,17 +86,19 @@ fn a_direct_pixel_sees_the_fraction_of_its_footprint_inside_the_light() {
         ..straddling_left
     };
     for (rect, exact) in [(straddling_left, 0.7), (corner_rect, 0.28)] {
-        let (mean, se, sd) = coefficient_draws(&scene, &plane, &rect, x, y, 20_000);
-        eprintln!("exact {exact}: mean {mean:.5} +- {se:.5}, one draw's sd {sd:.3}");
-        assert!(se < 1e-3, "standard error {se}");
-        assert!(
-            (mean - exact).abs() < 4.0 * se,
-            "{mean} +- {se} against {exact}"
-        );
-        // Stratified rays: one draw's spread is below that of 8 independent rays,
-        // sqrt(0.7 x 0.3 / 8) = 0.16 for the first rectangle (0.11 measured).
-        let independent = (exact * (1.0 - exact) / DIRECT_RAYS as f64).sqrt();
-        assert!(sd < 0.8 * independent, "sd {sd}, independent rays {independent}");
+        let c = coefficient(&scene, &plane, &rect, x, y);
+        assert!((c - exact).abs() < 1e-3, "{c} against {exact}");
+    }
+    // The share follows the edge linearly across the pixel, and is 0 and 1 beyond it.
+    for step in -4..=14 {
+        let f = step as f32 / 10.0;
+        let rect = Rect {
+            u_min: top_left.x + f * side,
+            ..straddling_left
+        };
+        let c = coefficient(&scene, &plane, &rect, x, y);
+        let exact = (1.0 - f as f64).clamp(0.0, 1.0);
+        assert!((c - exact).abs() < 1e-3, "edge at {f}: {c} against {exact}");
     }
     // A plane behind the wall is hidden by it: its rays' first hit is the wall, not its face.
     let behind = LightPlane {
@@ -121,7 +106,6 @@ fn a_direct_pixel_sees_the_fraction_of_its_footprint_inside_the_light() {
         ..plane.clone()
     };
     let roi = straddling_left.grow(5.0);
-    let mut rng = Rng::new(1, 77);
     let hits = direct_hits(
         &scene,
         &[&behind],
@@ -130,7 +114,6 @@ fn a_direct_pixel_sees_the_fraction_of_its_footprint_inside_the_light() {
         y,
         PHOTO_SIZE,
         PHOTO_SIZE,
-        &mut rng,
         1.0,
     );
     assert!(hits.is_empty(), "{} rays through the wall", hits.len());
@@ -141,9 +124,7 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
     let (scene, water, plane) = wall();
     // Table 1's light, 3 x 3 m from (-4, 2) on the wall, in plane coordinates (the scene
     // frame is the world's less `scene.origin`).
-    let at = |x: f64, y: f64| {
-        plane.coords((glam::DVec3::new(x, y, 0.0) - scene.origin).as_vec3())
-    };
+    let at = |x: f64, y: f64| plane.coords((glam::DVec3::new(x, y, 0.0) - scene.origin).as_vec3());
     let (lo, hi) = (at(-4.0, 2.0), at(-1.0, 5.0));
     let rect = Rect {
         u_min: lo.x,
@@ -153,7 +134,15 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
     };
     // Grown by 0.9 m: inside the photo, whose top row sees the wall at y = 5.97 m.
     let roi = rect.grow(0.9);
-    let pixels = direct_pixels(&scene, &[&plane], &[roi], PHOTO_SIZE, PHOTO_SIZE, &water, true);
+    let pixels = direct_pixels(
+        &scene,
+        &[&plane],
+        &[roi],
+        PHOTO_SIZE,
+        PHOTO_SIZE,
+        &water,
+        true,
+    );
     // 4.8 x 4.8 m at 10 m, 600 pixels over 2 tan(30 deg) 10 m: about 250 pixels a side, half of
     // them on the checkerboard.
     let metres_per_pixel = 20.0 * (30f32).to_radians().tan() / PHOTO_SIZE as f32;
@@ -173,6 +162,14 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
         v_max: at(0.0, 10.0).y,
         ..rect
     };
-    let none = direct_pixels(&scene, &[&plane], &[above], PHOTO_SIZE, PHOTO_SIZE, &water, true);
+    let none = direct_pixels(
+        &scene,
+        &[&plane],
+        &[above],
+        PHOTO_SIZE,
+        PHOTO_SIZE,
+        &water,
+        true,
+    );
     assert!(none.is_empty(), "{} pixels", none.len());
 }
