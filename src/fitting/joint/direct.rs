@@ -81,7 +81,7 @@ pub(super) fn direct_pixels(
     for y in y0..=y1 {
         for x in x0..=x1 {
             let i = (y * width + x) as usize;
-            if water[i] || (checkerboard && (x + y) % 2 != 0) {
+            if water[i] || (checkerboard && !(x + y).is_multiple_of(2)) {
                 continue;
             }
             let c = ((y - y0) as usize) * cw + (x - x0) as usize;

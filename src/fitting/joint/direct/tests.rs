@@ -155,7 +155,7 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
     assert!(pixels.iter().all(|&p| !water[p as usize]));
     assert!(pixels
         .iter()
-        .all(|&p| (p % PHOTO_SIZE + p / PHOTO_SIZE) % 2 == 0));
+        .all(|&p| (p % PHOTO_SIZE + p / PHOTO_SIZE).is_multiple_of(2)));
     // The same light moved above the top of the photo (the wall is seen up to y = 5.97 m).
     let above = Rect {
         v_min: at(0.0, 7.0).y,
