@@ -116,6 +116,12 @@ pub struct Args {
     /// this by default (see --joint-samples).
     #[arg(long)]
     pub all_pixels: bool,
+    /// Fit the water pixels alone: without this, the joint fit also reads the pixels that
+    /// see a light itself above the water (its direct image, clipped or not), whose edges pin
+    /// the light's edges to a fraction of a pixel. A light out of frame or hidden has none
+    /// either way.
+    #[arg(long)]
+    pub no_direct_view: bool,
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]
     pub allow_empty: bool,
@@ -147,6 +153,7 @@ impl Args {
             };
             Method::Joint(JointSettings {
                 repeats: self.repeats,
+                direct_view: !self.no_direct_view,
                 ..joint.reading_chosen(self.joint_samples, self.all_pixels)
             })
         };

@@ -276,6 +276,7 @@ impl Run<'_> {
             repeats: j.repeats,
             samples: reading.samples,
             checkerboard: !reading.all_pixels,
+            direct_view: j.direct_view,
             ..JointOptions::new(self.paper.model, self.paper.seed)
         }
     }

@@ -107,6 +107,11 @@ pub struct JointSettings {
     pub repeats: u32,
     /// The water's gloss: the scene's, or estimated from the photo.
     pub gloss: GlossFit,
+    /// Fit the pixels that see a light directly (above the water) too: where a light is in
+    /// the photo, its direct image pins its edges ([`JointOptions::direct_view`]).
+    ///
+    /// [`JointOptions::direct_view`]: crate::fitting::joint::JointOptions::direct_view
+    pub direct_view: bool,
 }
 
 impl Default for JointSettings {
@@ -121,6 +126,7 @@ impl Default for JointSettings {
             overlap_refit: Some(THOROUGH),
             repeats: 1,
             gloss: GlossFit::Given,
+            direct_view: true,
         }
     }
 }
@@ -138,6 +144,7 @@ impl JointSettings {
             overlap_refit: None,
             repeats: 1,
             gloss: GlossFit::Estimate(GlossSearch::default()),
+            direct_view: true,
         }
     }
 }

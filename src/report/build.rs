@@ -168,6 +168,7 @@ pub fn light_report(
             top: edge_report(&light.edges[EdgeSide::Top]),
         },
         uncertainty: uncertainty.and_then(|u| uncertainty_report(light, u)),
+        direct_pixels: uncertainty.map(|u| u.direct_pixels),
         light_index: None,
         node_index: None,
     }

@@ -116,6 +116,11 @@ pub struct LightReport {
     pub edges: EdgesReport,
     /// One-sigma uncertainties of the joint fit (`None` with `--method paper`).
     pub uncertainty: Option<UncertaintyReport>,
+    /// Pixels of the photo outside the water that see this light itself, among those the
+    /// joint fit read (every second one unless it read all): a count of pixels; 0 when the
+    /// light is out of frame or hidden, or the direct view was off; `None` with
+    /// `--method paper`.
+    pub direct_pixels: Option<usize>,
     /// Index of the light in the output's `EXT_lights_area.lights`.
     pub light_index: Option<usize>,
     /// Index of the light's node in the output.
@@ -170,12 +175,14 @@ pub struct EdgesReport {
 /// One edge's status.
 #[derive(Clone, Debug, Serialize)]
 pub struct EdgeReport {
-    /// "constrained" (measured from streak-edge pixels) or "unconstrained" (the streak's side
-    /// touches the photo's border or the water's end, so the value is a guess; or the edge
-    /// faces another light split from the same streak; `reason` says which).
+    /// "constrained" (measured from streak-edge pixels, or seen directly) or "unconstrained"
+    /// (the streak's side touches the photo's border or the water's end, so the value is a
+    /// guess; or the edge faces another light split from the same streak; `reason` says
+    /// which), where the photo does not show the edge directly either.
     pub status: String,
-    /// Streak-edge pixels it was estimated from: those that constrained it, or for an
-    /// unconstrained edge those read anyway (which may not show the real edge; 0 if none).
+    /// Pixels it was estimated from: the streak-edge pixels that constrained it (for an
+    /// unconstrained edge those read anyway, which may not show the real edge; 0 if none),
+    /// plus the pixels that see the edge itself (the joint fit's direct view).
     pub pixels: usize,
     /// Why it is unconstrained, if it is.
     pub reason: Option<String>,

@@ -264,6 +264,7 @@ pub fn estimate_gloss(
         model: paper.model,
         seed: paper.seed,
         progress: final_fit.progress,
+        direct_view: final_fit.direct_view,
     };
     let paper = fit_paper(scene, photo, water, streaks, &start_options)?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
@@ -407,6 +408,8 @@ struct SearchFit<'a> {
     model: ReflectionModel,
     seed: u64,
     progress: Reporter<'a>,
+    /// Whether the candidates' fits read the direct view, as the final fit does.
+    direct_view: bool,
 }
 
 /// The gloss whose lobe picks the fitted pixels for every candidate: a quarter of the start
@@ -455,6 +458,7 @@ impl Cost<'_> {
                 // would fit the lobe's error, not a second light.
                 split: false,
                 region_gloss: Some(region_gloss(self.options, self.fit.model.gloss)),
+                direct_view: self.fit.direct_view,
                 ..JointOptions::new(
                     ReflectionModel {
                         gloss,

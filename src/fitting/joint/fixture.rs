@@ -82,6 +82,7 @@ impl Table3Light0 {
             0,
             draw,
             cv,
+            self.pixels.len(),
             crate::progress::Reporter::default(),
         )
     }

@@ -126,9 +126,13 @@ fn coverage(x: f32, h: f32, lo: f32, hi: f32) -> f32 {
 
 /// The sample kernel's mass inside `[lo, hi]`: `(4 B(h/2) - B(h)) / 3` of two boxes of
 /// half-widths h/2 and h ([`coverage`]), a kernel whose second moment vanishes (see the module
-/// doc).
+/// doc). A negative `h` is the plain box `B(-h)`: a direct pixel's stratum
+/// ([`super::direct`]), whose share inside the interval is exact.
 #[inline]
 pub(super) fn kernel_coverage(x: f32, h: f32, lo: f32, hi: f32) -> f32 {
+    if h < 0.0 {
+        return coverage(x, -h, lo, hi);
+    }
     let (a, b) = (x - h, x + h);
     if a >= lo && b <= hi {
         1.0

@@ -11,7 +11,10 @@
 //! method §2). The fitted region is the streaks, dilated, plus every pixel near them whose
 //! reflected rays can reach a light's region of interest: a streak's faint ends fall below
 //! any segmentation's threshold, and an edge seen only through them would otherwise drift
-//! (`region`).
+//! (`region`). Where a light itself is in the photo, the pixels outside the water that see
+//! its wall are fitted too: their coefficient is the fraction of their camera rays that land
+//! inside the rectangle, and the edges they cross pin it to a fraction of a pixel
+//! (`direct`).
 //!
 //! Each pixel's coefficient is integrated over its footprint as the renderer does it (the
 //! forward model is a [`WaterModel`], by default the exact surface the renderer uses):
@@ -58,6 +61,7 @@
 //! |---|---|
 //! | `mod.rs` | options, outcome, [`fit_joint`] |
 //! | `region` | the fitted pixels, each light's region of interest |
+//! | `direct` | the pixels that see a light's wall directly, their samples |
 //! | `samples` | tracing and storing the plane samples, a coefficient from them |
 //! | `kernel` | each sample's cell and kernel |
 //! | `control_variate` | the lobe Gaussian |
@@ -87,6 +91,7 @@ mod boundary;
 mod control_variate;
 mod cost;
 mod descent;
+mod direct;
 #[cfg(test)]
 mod fixture;
 mod kernel;
@@ -103,6 +108,7 @@ mod uncertainty;
 pub use samples::effective_samples;
 pub use uncertainty::{edge_statuses, Uncertainty};
 
+use direct::direct_pixels;
 use optimise::optimise;
 use problem::{Problem, State};
 use region::{region, region_of_interest};
@@ -150,6 +156,10 @@ pub struct JointOptions<'a> {
     /// Estimate the coefficients with the lobe Gaussian as a control variate (see the module
     /// doc): the same expectation, far less noise. Off only to measure what it brings.
     pub control_variate: bool,
+    /// Fit the pixels outside the water that see a light's wall directly too (`direct`):
+    /// where a light is in the photo, its direct image pins its edges to a fraction of a
+    /// pixel. Off, only the water pixels are read.
+    pub direct_view: bool,
 }
 
 impl JointOptions<'_> {
@@ -168,6 +178,7 @@ impl JointOptions<'_> {
             repeats: 1,
             progress: Reporter::default(),
             control_variate: true,
+            direct_view: true,
         }
     }
 }
@@ -182,7 +193,8 @@ pub struct JointOutcome {
     pub lights: Vec<FittedLight>,
     /// Their uncertainties, in the same order.
     pub uncertainty: Vec<Uncertainty>,
-    /// Pixels in the fitted region.
+    /// Pixels in the fitted region: the water pixels and, with the direct view, those that
+    /// see a light's wall directly.
     pub pixels: usize,
     /// Residual sum of squares per pixel and channel at the optimum (radiance units squared).
     pub residual_variance: f64,
@@ -192,8 +204,9 @@ pub struct JointOutcome {
     pub cost: f64,
     /// Wall-clock seconds: "footprints" and "optimise".
     pub timings: Vec<(String, f64)>,
-    /// The fitted pixels (index `y * width + x` into the photo) with their modelled radiance
-    /// at the optimum, per channel: the expected image the photo was compared with.
+    /// The fitted water pixels (index `y * width + x` into the photo) with their modelled
+    /// radiance at the optimum, per channel: the expected image the photo was compared with
+    /// (the direct view's pixels left out).
     pub modelled: Vec<(u32, [f32; 3])>,
 }
 
@@ -288,7 +301,7 @@ pub fn fit_joint_with(
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model
     };
-    let pixels = region(
+    let mut pixels = region(
         options.region_water.unwrap_or(water_model),
         scene,
         &probe_model,
@@ -300,6 +313,19 @@ pub fn fit_joint_with(
         options.margin,
         options.checkerboard,
     );
+    // The pixels that see the lights' walls directly follow the water pixels.
+    let first_direct = pixels.len();
+    if options.direct_view {
+        pixels.extend(direct_pixels(
+            scene,
+            &planes,
+            &roi,
+            photo.width,
+            photo.height,
+            water,
+            options.checkerboard,
+        ));
+    }
     let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
         trace_samples(
             water_model,
@@ -315,6 +341,7 @@ pub fn fit_joint_with(
             repeat,
             draw,
             options.control_variate,
+            first_direct,
             options.progress,
         )
     };
@@ -328,6 +355,7 @@ pub fn fit_joint_with(
             planes: stored,
             set_origin: (0..planes.len()).collect(),
             inv_samples: 1.0 / per_pixel_samples as f32,
+            first_direct,
         }
     };
     // Seconds spent tracing the split lights' own sample sets (footprints, not optimisation).
@@ -419,7 +447,9 @@ pub fn fit_joint_with(
         u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
     }
     optimise_seconds += t2.elapsed().as_secs_f64();
-    let modelled = (0..problem.n())
+    // The water pixels alone: the direct view's sharp image of a light would match the photo
+    // whatever the water model.
+    let modelled = (0..problem.first_direct)
         .map(|i| {
             (
                 problem.pixel_ids[i],
@@ -428,10 +458,14 @@ pub fn fit_joint_with(
         })
         .collect();
     let facing = facing_edges(&problem, &st);
+    for (k, u) in uncertainty.iter_mut().enumerate() {
+        u.direct_pixels = problem.direct_pixels_inside(st.set_of[k], &st.rects[k]);
+    }
     let lights = (0..st.rects.len())
         .map(|k| {
             let origin = &start[problem.set_origin[st.set_of[k]]];
             let (r, rad) = (st.rects[k], st.radiance[k]);
+            let direct = problem.direct_edge_pixels(st.set_of[k], &r);
             let mut edges = origin.edges.clone();
             for side in EdgeSide::ALL {
                 if facing[k][side] {
@@ -439,6 +473,17 @@ pub fn fit_joint_with(
                         reason: FACING_REASON.into(),
                         pixels: 0,
                         unseen: false,
+                    };
+                }
+                // An edge the photo shows directly is constrained by the pixels it crosses,
+                // whatever the reflections say of it.
+                if direct[side] > 0 {
+                    let reflected = match edges[side] {
+                        EdgeStatus::Constrained { pixels } => pixels,
+                        EdgeStatus::Unconstrained { .. } => 0,
+                    };
+                    edges[side] = EdgeStatus::Constrained {
+                        pixels: reflected + direct[side],
                     };
                 }
             }

@@ -15,7 +15,7 @@ use super::problem::{Problem, State};
 use super::samples::{sample_extent, PlaneSamples};
 use super::split::try_split;
 use crate::fitting::rect::Rect;
-use crate::fitting::{EdgeStatus, FittedLight};
+use crate::fitting::{EdgeSide, EdgeStatus, FittedLight};
 use crate::progress::Reporter;
 
 /// Fits the lights from `start`: a descent, then a split of any light whose residual is
@@ -35,21 +35,30 @@ pub(super) fn optimise(
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     progress: Reporter<'_>,
 ) -> (State, State) {
+    let rects: Vec<Rect> = start
+        .iter()
+        .zip(extents.iter())
+        .map(|(l, e)| e.map_or(l.rect(), |e| l.rect().clamp_to(&e)))
+        .collect();
+    // An edge no streak-edge pixel looks at is held, unless the photo shows it directly.
+    let pinned = start
+        .iter()
+        .zip(&rects)
+        .enumerate()
+        .map(|(k, (l, r))| {
+            let direct = problem.direct_edge_pixels(k, r);
+            EdgeSide::ALL.map(|side| {
+                matches!(
+                    l.edges[side],
+                    EdgeStatus::Unconstrained { unseen: true, .. }
+                ) && direct[side] == 0
+            })
+        })
+        .collect();
     let mut st = problem.state(
         (0..start.len()).collect(),
-        start
-            .iter()
-            .map(|l| {
-                l.edges
-                    .clone()
-                    .map(|e| matches!(e, EdgeStatus::Unconstrained { unseen: true, .. }))
-            })
-            .collect(),
-        start
-            .iter()
-            .zip(extents.iter())
-            .map(|(l, e)| e.map_or(l.rect(), |e| l.rect().clamp_to(&e)))
-            .collect(),
+        pinned,
+        rects,
         start.iter().map(|l| l.radiance.map(f64::from)).collect(),
     );
     let mut replay = st.clone();

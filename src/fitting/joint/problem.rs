@@ -24,6 +24,9 @@ pub(super) struct Problem {
     pub(super) set_origin: Vec<usize>,
     /// One over the samples drawn per pixel: the divisor of every coefficient.
     pub(super) inv_samples: f32,
+    /// The fitted pixels from this index on see the lights' walls directly (outside the
+    /// water: [`super::direct`]); those before it are water pixels.
+    pub(super) first_direct: usize,
 }
 
 /// The state of a fit: every light's rectangle and radiance, and the coefficients they give.

@@ -170,8 +170,8 @@ impl EdgeRamps {
         }
     }
 
-    /// Adds a sample's kernel of half-width h at x along the edge's axis ([`kernel_coverage`])
-    /// with its weights (absolute, signed) for a min edge (`min_edge`: the kernel counts above
+    /// Adds a sample's kernel of half-width h at x along the edge's axis ([`kernel_coverage`];
+    /// a negative h is a plain box) with its weights (absolute, signed) for a min edge (`min_edge`: the kernel counts above
     /// the edge and below `opp`, the opposite edge) or a max edge (below the edge and above
     /// `opp`). Returns whether it counts anywhere.
     pub(super) fn add_cell(
@@ -183,7 +183,8 @@ impl EdgeRamps {
         abs: f64,
         signed: f64,
     ) -> bool {
-        let (reach_lo, reach_hi) = (x - h.max(POINT_CELL), x + h.max(POINT_CELL));
+        let reach = h.abs().max(POINT_CELL);
+        let (reach_lo, reach_hi) = (x - reach, x + reach);
         // Nowhere on the grid (the last grid point is below the cell, or the first above it).
         if (min_edge && (reach_hi.min(opp) as f64) <= self.lo)
             || (!min_edge && (reach_lo.max(opp) as f64) >= self.hi)
@@ -200,6 +201,10 @@ impl EdgeRamps {
         if let Some(f) = beyond {
             self.constant(abs * f as f64, signed * f as f64);
             return f != 0.0;
+        }
+        if h < 0.0 {
+            // A plain box: a direct pixel's stratum (see `kernel_coverage`).
+            return self.add_box(min_edge, x, -h, opp, abs, signed);
         }
         if h > POINT_CELL {
             let a = self.add_box(
@@ -303,7 +308,7 @@ mod tests {
     #[test]
     fn edge_ramps_match_the_kernels_mass_at_every_grid_point() {
         // Random cells (some points, some wider than the grid, some cut by the opposite
-        // edge) against the direct coverage sum, for both kinds of edge.
+        // edge, some plain boxes) against the direct coverage sum, for both kinds of edge.
         let mut rng = Rng::new(7, 0);
         let (lo, step, grid) = (-0.3f32, 0.01f32, 65);
         for min_edge in [true, false] {
@@ -313,9 +318,11 @@ mod tests {
             let mut cells = Vec::new();
             for n in 0..200 {
                 let x = -0.6 + 1.2 * rng.next_f32();
-                let h = match n % 4 {
+                // A negative half-width is a plain box (a direct pixel's stratum).
+                let h = match n % 5 {
                     0 => 0.0,
                     1 => 0.5 * rng.next_f32(),
+                    4 => -0.05 * rng.next_f32() - 1e-3,
                     _ => 0.05 * rng.next_f32(),
                 };
                 let w = if n % 3 == 0 { -1.0 } else { 1.0 } * (0.5 + rng.next_f32());
@@ -336,7 +343,9 @@ mod tests {
                         ((b.min(x + h) - a.max(x - h)) / (2.0 * h)).clamp(0.0, 1.0)
                     };
                     let h = h as f64;
-                    let f = if h > POINT_CELL as f64 {
+                    let f = if h < 0.0 {
+                        boxed(-h)
+                    } else if h > POINT_CELL as f64 {
                         (4.0 * boxed(0.5 * h) - boxed(h)) / 3.0
                     } else {
                         boxed(h)

@@ -19,6 +19,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use super::control_variate::{self, LobeGaussian};
+use super::direct::{direct_hits, Hit, DIRECT_RAYS};
 use super::kernel::{cell_half_extents, kernel_coverage, LobeNeighbours};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
@@ -45,12 +46,15 @@ pub(super) struct PlaneSamples {
     /// Per sample, where it lands (plane coordinates).
     pub(super) points: Vec<Vec2>,
     /// Per sample, the half-widths of its kernel along the plane's axes (see
-    /// [`cell_half_extents`] and [`super::kernel`]).
+    /// [`cell_half_extents`] and [`super::kernel`]); negative for a direct pixel's sample,
+    /// whose kernel is the plain box of its stratum ([`super::direct`]).
     pub(super) cells: Vec<Vec2>,
     /// Per sample, its weight less the control variate's (see [`super::control_variate`]):
-    /// negative where the Gaussian outweighs the lobe.
+    /// negative where the Gaussian outweighs the lobe. A direct pixel's samples (see
+    /// [`super::direct`]) weigh the pixel's sample count over its strata.
     pub(super) weights: Vec<f32>,
-    /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1).
+    /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1); 0
+    /// for a direct pixel's samples, whose coefficient is exact (no noise to measure).
     pub(super) halves: Vec<f32>,
     /// Per pixel, the control variate ([`LobeGaussian::NONE`] without).
     pub(super) gauss: Vec<LobeGaussian>,
@@ -131,7 +135,9 @@ fn lobe_strata(samples: u32) -> u32 {
 /// wherever the Gaussian is, or the estimate would see light through the obstacle.
 /// `repeat` and `draw` select independent random streams: `draw` 0 is the set every start
 /// light reads, `draw` 1, 2, ... the sets of lights that splits added (one plane each).
-/// `progress` hears the count of pixels traced.
+/// The pixels from `first_direct` on see the lights' walls directly: their samples are their
+/// strata's camera rays ([`super::direct`]), without a control variate. `progress` hears the
+/// count of pixels traced.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn trace_samples(
     water_model: &dyn WaterModel,
@@ -147,11 +153,13 @@ pub(super) fn trace_samples(
     repeat: u32,
     draw: u32,
     gaussians: bool,
+    first_direct: usize,
     progress: Reporter<'_>,
 ) -> (Vec<PlaneSamples>, u32) {
-    type Hits = (Vec<(u16, Vec2, Vec2, f32, f32)>, Vec<LobeGaussian>);
+    type Hits = (Vec<Hit>, Vec<LobeGaussian>);
     let lobe = lobe_strata(samples);
     let per_pixel_samples = effective_samples(samples);
+    let direct_weight = per_pixel_samples as f32 / DIRECT_RAYS as f32;
     let total = pixels.len() as u64;
     let traced = AtomicU64::new(0);
     // About a hundred reports over the whole set.
@@ -159,7 +167,8 @@ pub(super) fn trace_samples(
     progress.advance(0, total);
     let per_pixel: Vec<Hits> = pixels
         .par_iter()
-        .map(|&pixel| {
+        .enumerate()
+        .map(|(index, &pixel)| {
             let done = traced.fetch_add(1, Ordering::Relaxed) + 1;
             if done.is_multiple_of(every) || done == total {
                 progress.advance(done, total);
@@ -167,6 +176,10 @@ pub(super) fn trace_samples(
             let stream = JOINT_STREAM | (draw as u64) << 52 | (repeat as u64) << 32 | pixel as u64;
             let mut rng = Rng::new(seed, stream);
             let (x, y) = (pixel % width, pixel / width);
+            if index >= first_direct {
+                let hits = direct_hits(scene, planes, roi, x, y, width, height, direct_weight);
+                return (hits, vec![LobeGaussian::NONE; planes.len()]);
+            }
             let mut hits = Vec::new();
             let mut missed_water = 0u32;
             // The control variates, matched to the pixel's first camera ray to meet the water
@@ -323,12 +336,14 @@ pub(super) fn trace_samples(
                 let first = *out.offsets.last().unwrap_or(&0) as usize;
                 let mut bb = Rect::EMPTY;
                 for (p, h) in out.points[first..].iter().zip(&out.cells[first..]) {
-                    bb = bb.union(&Rect::around(*p, *h));
+                    bb = bb.union(&Rect::around(*p, h.abs()));
                 }
                 out.bbox.push(bb);
                 out.offsets.push(out.points.len() as u32);
             }
-            out.min_size = smallest_light(&out.cells);
+            // From the water pixels' samples alone: the bound is about the lobes' kernels.
+            let lobe_samples = out.offsets[first_direct.min(pixels.len())] as usize;
+            out.min_size = smallest_light(&out.cells[..lobe_samples]);
             out
         })
         .collect();

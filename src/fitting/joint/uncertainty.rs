@@ -15,18 +15,25 @@ pub struct Uncertainty {
     pub edges: [Option<f32>; 4],
     /// Radiance per channel, in radiance units.
     pub radiance: [f32; 3],
+    /// Fitted pixels outside the water that see the light itself (a sample of their camera
+    /// rays lands inside its rectangle): 0 for a light out of frame or hidden, or with the
+    /// direct view off. The edges they cross pin the rectangle to a fraction of a pixel
+    /// (their sigmas say how well).
+    pub direct_pixels: usize,
 }
 
 /// One-sigma uncertainties of every light's free edges and radiances, from their full
 /// covariance at once (Gauss-Newton, made robust to uneven noise: see below), J being the
-/// model's derivatives at every unclipped fitted pixel and channel. Holding the other
-/// parameters fixed, as a per-edge curvature would, understates errors that travel along
-/// correlated directions (a light's height against its radiance when only one end of its
-/// streak is seen); the full covariance carries them.
+/// model's derivatives at every fitted pixel that measures it and every channel. Holding the
+/// other parameters fixed, as a per-edge curvature would, understates errors that travel
+/// along correlated directions (a light's height against its radiance when only one end of
+/// its streak is seen); the full covariance carries them.
 ///
 /// An edge's derivative is the change of the coefficients over a step of 2 % of the light's
 /// size (at least 5 mm) each way: below a few millimetres the stored samples make the
-/// coefficients a staircase. An edge that moves nothing gets no uncertainty (`None`: the photo
+/// coefficients a staircase. A direct pixel's (`direct`) is taken over a quarter of its
+/// footprint, and only the pixels that measure the model count ([`Problem::measures`]: not
+/// clipped, and not black where the light is seen directly). An edge that moves nothing gets no uncertainty (`None`: the photo
 /// does not constrain it), and so does a pinned one.
 pub(super) fn uncertainties(
     problem: &Problem,
@@ -50,8 +57,30 @@ pub(super) fn uncertainties(
             }
             let e = r.edge(side);
             let set = st.set_of[k];
-            let (g, g_dev) =
+            let (mut g, mut g_dev) =
                 problem.edge_slopes(set, &r.with_edge(side, e + h), &r.with_edge(side, e - h), h);
+            // The direct pixels' coefficients are smooth on a far finer scale.
+            if let Some(hd) = problem.direct_step(set, side.along_u()) {
+                let (gd, gd_dev) = problem.edge_slopes(
+                    set,
+                    &r.with_edge(side, e + hd),
+                    &r.with_edge(side, e - hd),
+                    hd,
+                );
+                let direct = problem.first_direct..problem.n();
+                // A handful of pixels (the corners of a light whose sides lie between a black
+                // and a clipped column) cannot tell their own noise: their scatter would make
+                // the sigma, and it came out at a fifth of the error on the stacked1000
+                // sample. Such an edge is left to the other pixels.
+                let measuring = direct
+                    .clone()
+                    .filter(|&i| gd[i] != 0.0 && problem.measures(i))
+                    .count();
+                let keep = measuring >= MIN_DIRECT_PIXELS;
+                for i in direct {
+                    (g[i], g_dev[i]) = if keep { (gd[i], gd_dev[i]) } else { (0.0, 0.0) };
+                }
+            }
             if g.iter().any(|&x| x != 0.0) {
                 params.push(Param::Edge(k, side, g, g_dev));
             }
@@ -92,7 +121,7 @@ pub(super) fn uncertainties(
     let mut row = vec![0.0; p];
     let mut dev_row = vec![0.0; p];
     let mut score = vec![0.0; p];
-    for i in (0..problem.n()).filter(|&i| !problem.clipped[i]) {
+    for i in (0..problem.n()).filter(|&i| problem.measures(i)) {
         let m = problem.model(st, i);
         score.iter_mut().for_each(|x| *x = 0.0);
         let mut any = false;
@@ -155,6 +184,7 @@ pub(super) fn uncertainties(
         .map(|_| Uncertainty {
             edges: [None; 4],
             radiance: [f32::INFINITY; 3],
+            direct_pixels: 0,
         })
         .collect();
     if let Some(cov) = covariance {
@@ -173,6 +203,10 @@ pub(super) fn uncertainties(
     }
     out
 }
+
+/// Fewest direct pixels that must measure an edge (not clipped, not black, moved by it) for
+/// them to count in its uncertainty (see [`uncertainties`]).
+const MIN_DIRECT_PIXELS: usize = 16;
 
 /// Why an edge that faces another light split from the same start is reported unconstrained.
 pub(super) const FACING_REASON: &str =

@@ -200,6 +200,7 @@ mod tests {
         let mut u = vec![Uncertainty {
             edges: [Some(0.03), None, Some(0.01), Some(0.01)],
             radiance: [0.1; 3],
+            direct_pixels: 0,
         }];
         widen(&mut u, 4.0, [Some(&s), None], [Some(0.1), None]);
         // Left: (0.03 * 2)^2 + (0.5 * 0.1)^2; radiance: (0.1 * 2)^2 + (2 * 0.1)^2.
