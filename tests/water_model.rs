@@ -13,6 +13,14 @@ use streaklight::scene_in::Scene;
 use streaklight::tracing::{Tracer, Triangle};
 use streaklight::water_model::water_statistics;
 
+/// The settings with the water model chosen from the photo.
+fn auto() -> FitSettings {
+    FitSettings {
+        water: WaterChoice::Auto,
+        ..FitSettings::default()
+    }
+}
+
 /// `scene` with its water flattened onto its mean level (world y = 0), normals straight up.
 fn flattened(mut scene: Scene) -> Scene {
     let level = -scene.origin.y as f32;
@@ -45,7 +53,7 @@ fn flattened(mut scene: Scene) -> Scene {
 fn the_scenes_own_waves_keep_the_exact_model() {
     let scene = sample_scene("scene.gltf", None);
     let photo = sample_photo("table1.png");
-    let lit = pipeline::fit(&scene, &photo, &FitSettings::default(), Reporter::default()).unwrap();
+    let lit = pipeline::fit(&scene, &photo, &auto(), Reporter::default()).unwrap();
     let used = &lit.water_model;
     assert_eq!((used.model, used.chosen), ("exact", "detected"));
     let c = used.fine_structure_correlation.unwrap();
@@ -73,7 +81,7 @@ fn a_flat_quad_takes_the_statistical_model() {
     let micro = 1.0 / (waves.water.gloss + 2.0);
     let truth_across = truth_stats.slope_variance[1] + micro;
     let flat = flattened(waves);
-    let lit = pipeline::fit(&flat, &photo, &FitSettings::default(), Reporter::default()).unwrap();
+    let lit = pipeline::fit(&flat, &photo, &auto(), Reporter::default()).unwrap();
     let used = &lit.water_model;
     assert_eq!((used.model, used.chosen), ("statistical", "detected"));
     assert!(used.fine_structure_correlation.unwrap() < 0.2, "{used:?}");

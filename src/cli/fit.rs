@@ -95,8 +95,8 @@ pub struct Args {
     /// scene gives the mean water surface, a flat quad or another field of waves, and the
     /// waves' slopes are estimated from the photo, along and across the view), or "auto"
     /// (exact if its fine structure matches the photo's, else statistical; the report says
-    /// which, and why).
-    #[arg(long, default_value = "auto", value_parser = ["auto", "exact", "statistical"])]
+    /// which, and why; not yet reliable on every scene, so not the default).
+    #[arg(long, default_value = "exact", value_parser = ["auto", "exact", "statistical"])]
     pub water_model: String,
     /// Run the joint fit this many times, each from its own samples, and report the mean: N
     /// times slower, about sqrt(N) times less of the samples' noise; the uncertainties add the

@@ -32,7 +32,7 @@ pub struct FitSettings {
 impl Default for FitSettings {
     /// The defaults of `streaklight fit`: [`DEFAULT_SAMPLES`] samples, seed 1, the paper's
     /// G = 1, the default streak extraction, the joint method with the scene's gloss, the
-    /// water model chosen from the photo.
+    /// exact water model.
     fn default() -> Self {
         FitSettings {
             samples: DEFAULT_SAMPLES,
