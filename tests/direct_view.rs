@@ -103,8 +103,10 @@ fn the_direct_view_pins_table1s_light() {
         (&l_on.edges.top, &l_off.edges.top),
     ] {
         assert_eq!(on.status, "constrained");
+        // Without the view an edge may be unconstrained, its count then the pixels read
+        // anyway (which need not show it): only constrained counts compare.
         assert!(
-            on.pixels > off.pixels + 50,
+            off.status != "constrained" || on.pixels > off.pixels + 50,
             "{} against {}",
             on.pixels,
             off.pixels
