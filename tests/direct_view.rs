@@ -130,11 +130,14 @@ fn the_direct_view_pins_table1s_light() {
         let s = s.unwrap_or_else(|| panic!("{side} has a sigma"));
         assert!(e.abs() < 5.0 * s, "{side}: {e} m off, sigma {s} m");
     }
-    let (top_on, top_off) = (s_on[3].unwrap_or(0.0), s_off[3].unwrap_or(0.0));
-    assert!(
-        top_on < 0.5 * top_off,
-        "top sigma {top_on} against {top_off}"
-    );
+    // Without the view the top edge may be unconstrained (no sigma): then being constrained
+    // with it (checked above) is the gain; otherwise its sigma at least halves.
+    if let (Some(top_on), Some(top_off)) = (s_on[3], s_off[3]) {
+        assert!(
+            top_on < 0.5 * top_off,
+            "top sigma {top_on} against {top_off}"
+        );
+    }
 }
 
 /// A light above the top of the photo: the camera looks down 25 degrees, so the top of the
