@@ -13,7 +13,7 @@ use crate::pipeline::{self, light_name, FitSettings, Input, Lit};
 use crate::progress::Reporter;
 use crate::report::{self, Files, Report};
 use crate::scene_in::{self, AreaLight, LoadOptions, Scene};
-use crate::scene_out::{self, LightToWrite, WriteOptions};
+use crate::scene_out::{self, InputFiles, LightToWrite, WriteOptions};
 use crate::settings::{reword, Setting};
 use crate::{output_file, photo_out, render, streaks, Error, Result};
 
@@ -40,6 +40,10 @@ pub struct ConvertOptions<'a> {
     pub fit: FitSettings,
     /// Write emissive fallback quads under the lights.
     pub fallback_quads: bool,
+    /// Metres each light's node sits in front of its wall ([`WriteOptions::light_offset`]).
+    pub light_offset: f64,
+    /// Where a `.gltf` output finds the input's files ([`WriteOptions::input_files`]).
+    pub input_files: InputFiles,
     /// Succeed (writing the scene unchanged) when no light is found.
     pub allow_empty: bool,
     /// Told as each stage of the run starts (silent by default).
@@ -68,6 +72,8 @@ impl ConvertOptions<'_> {
             exposure: 1.0,
             fit: FitSettings::default(),
             fallback_quads: true,
+            light_offset: scene_out::DEFAULT_LIGHT_OFFSET,
+            input_files: InputFiles::Copy,
             allow_empty: false,
             progress: Reporter::default(),
             wording: |s| s.to_string(),
@@ -110,6 +116,12 @@ fn check_output(options: &ConvertOptions) -> Result<()> {
             &options.output,
             "the output must end in .gltf or .glb",
         ));
+    }
+    if !(options.light_offset.is_finite() && options.light_offset >= 0.0) {
+        return Err(Error::Usage(format!(
+            "the light offset must be a number of metres >= 0, not {}",
+            options.light_offset
+        )));
     }
     let inputs = [options.scene.as_path(), options.photo.as_path()];
     output_file::ensure_not_an_input(&options.output, &inputs)?;
@@ -215,9 +227,13 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
             &WriteOptions {
                 fallback_quads: options.fallback_quads,
                 nits_scale: options.load.nits_scale,
+                light_offset: options.light_offset,
+                input_files: options.input_files,
             },
         )
     })?;
+    lit.warnings
+        .extend(summary.resources.warnings.iter().cloned());
     if let Some(dir) = &options.debug_dir {
         timed(&mut after, progress, "debug pictures", || {
             write_debug(dir, &scene, &photo, &lit, options)
@@ -242,7 +258,9 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     for (k, r) in report.lights.iter_mut().enumerate() {
         r.light_index = summary.light_indices.get(k).copied();
         r.node_index = summary.node_indices.get(k).copied();
+        r.node_translation = summary.node_translations.get(k).copied();
     }
+    report.settings.light_offset = Some(options.light_offset);
     if let Some(path) = &options.report {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| Error::output(path, e.to_string()))?;

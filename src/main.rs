@@ -19,6 +19,9 @@ enum Command {
     Segment(cli::segment::Args),
     /// Render the water and the EXT_lights_area lights of a scene as its camera sees them.
     Render(cli::render::Args),
+    /// Put back the EXT_lights_area lights of a fit output from its fallback quads, after a
+    /// tool without the extension dropped them.
+    RestoreLights(cli::restore_lights::Args),
     /// Write the sample scenes of the paper's setup and render their photos.
     Samples(cli::samples::Args),
 }
@@ -29,6 +32,7 @@ fn main() -> ExitCode {
         Command::Segment(args) => cli::segment::run(args),
         Command::Render(args) => cli::render::run(args),
         Command::Samples(args) => cli::samples::run(args),
+        Command::RestoreLights(args) => cli::restore_lights::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,6 +6,7 @@ use streaklight::convert::{convert, ConvertOptions};
 use streaklight::pipeline::{FitSettings, JointSettings, Method, WaterChoice};
 use streaklight::progress::Reporter;
 
+use super::output_args::OutputArgs;
 use super::scene_args::SceneArgs;
 use super::streak_args::StreakArgs;
 
@@ -75,6 +76,14 @@ pub struct Args {
     /// this by default (see --joint-samples).
     #[arg(long)]
     pub all_pixels: bool,
+    /// How far in front of its wall each light is written, in metres, along the direction it
+    /// emits: a light exactly in the wall's plane is shadowed by the wall in renderers that
+    /// trace shadow rays (Blender's Cycles among them). The report records it.
+    #[arg(long, value_name = "METRES", default_value_t = streaklight::scene_out::DEFAULT_LIGHT_OFFSET)]
+    pub light_offset: f64,
+    /// Output-file options.
+    #[command(flatten)]
+    pub files: OutputArgs,
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]
     pub allow_empty: bool,
@@ -140,6 +149,8 @@ pub fn run(args: Args) -> streaklight::Result<()> {
         }),
         exposure: args.exposure,
         fallback_quads: !args.no_fallback_quads,
+        light_offset: args.light_offset,
+        input_files: args.files.input_files(),
         allow_empty: args.allow_empty,
         progress: Reporter::new(&terminal),
         wording: super::flags::flag,

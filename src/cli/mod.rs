@@ -2,8 +2,10 @@
 
 pub mod fit;
 pub mod flags;
+pub mod output_args;
 pub mod progress;
 pub mod render;
+pub mod restore_lights;
 pub mod samples;
 pub mod scene_args;
 pub mod segment;

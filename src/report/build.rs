@@ -64,6 +64,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             }),
             exposure: run.exposure,
             nits_scale: run.nits_scale,
+            light_offset: None,
             method: settings.method.name().into(),
             camera: scene.camera.name.clone(),
             water: scene.water.name.clone(),
@@ -153,6 +154,7 @@ pub fn light_report(
         uncertainty: uncertainty.and_then(uncertainty_report),
         light_index: None,
         node_index: None,
+        node_translation: None,
     }
 }
 

@@ -188,7 +188,12 @@ pub(crate) fn append(
             json!({
                 "name": label,
                 "mesh": mesh,
-                "extras": { "streaklight": { "role": "fallback-quad" } },
+                // What restore-lights needs to rebuild the light from the quad alone: the
+                // light object, and the quad's node frame is the light's.
+                "extras": { "streaklight": {
+                    "role": "fallback-quad",
+                    "light": super::lights::light_json(light),
+                } },
             }),
             input,
         )?);
@@ -213,6 +218,7 @@ mod tests {
             color: [1.0; 3],
             intensity: 1.0,
             streak: None,
+            offset: 0.0,
         };
         let c = corners(&light).map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
         for t in INDICES.chunks(3) {
