@@ -189,10 +189,15 @@ pub(crate) fn append(
                 "name": label,
                 "mesh": mesh,
                 // What restore-lights needs to rebuild the light from the quad alone: the
-                // light object, and the quad's node frame is the light's.
+                // light object and its node's transform in the world. Tools that drop the
+                // extension may flatten, move or requantise the quad itself.
                 "extras": { "streaklight": {
                     "role": "fallback-quad",
                     "light": super::lights::light_json(light),
+                    "light_node": {
+                        "translation": light.translation,
+                        "rotation": light.rotation,
+                    },
                 } },
             }),
             input,

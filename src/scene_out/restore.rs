@@ -1,18 +1,19 @@
 //! `restore-lights`: bring back the `EXT_lights_area` lights that a tool without the extension
 //! dropped (glTF-Transform without its Extension class drops unknown extensions, but keeps
-//! nodes, meshes and extras). Every fallback quad carries its light's object in
-//! `extras.streaklight.light`, and the quad's node frame is the light's (it is a child of the
-//! light's node without a transform of its own), so the quad alone rebuilds the light:
+//! nodes, meshes and extras). Every fallback quad carries its light's object and its light
+//! node's world transform in `extras.streaklight` (`light`, `light_node`), so the quad alone
+//! rebuilds the light, wherever a tool moved or requantised the quad itself:
 //!
-//! - its parent is a streaklight light node without the extension: the light goes back on it;
-//! - otherwise (a tool flattened the hierarchy or removed the parent): a new light node at the
-//!   quad's world transform, in the default scene.
+//! - its parent is a streaklight light node without the extension (the hierarchy is as
+//!   written): the light goes back on it;
+//! - otherwise (a tool flattened the hierarchy or removed the parent): a new light node with
+//!   the recorded transform, in the default scene.
 //!
-//! A quad whose parent still has its light is left alone.
+//! A quad whose light is still in the document (on its parent, or on a node whose light has
+//! the same name) is left alone.
 
 use std::path::Path;
 
-use glam::{DMat4, DQuat, DVec3};
 use serde_json::{json, Value};
 
 use super::edit::{array_mut, object_mut, push, root_mut, use_extension};
@@ -34,8 +35,8 @@ pub struct RestoreSummary {
 /// module docs) and writes the result as `output`, self-contained like every output.
 pub fn restore_lights(input: &Path, output: &Path, files: InputFiles) -> Result<RestoreSummary> {
     let mut staged = staged::stage(input, output, files)?;
-    let root = root_mut(&mut staged.json, input)?;
-    let nodes: Vec<Value> = root
+    let nodes: Vec<Value> = staged
+        .json
         .get("nodes")
         .and_then(Value::as_array)
         .cloned()
@@ -60,6 +61,21 @@ pub fn restore_lights(input: &Path, output: &Path, files: InputFiles) -> Result<
             .pointer(&format!("/extensions/{EXTENSION}/light"))
             .is_some()
     };
+    // Names of the lights the document's nodes still have.
+    let present: Vec<Value> = nodes
+        .iter()
+        .filter_map(|n| {
+            n.pointer(&format!("/extensions/{EXTENSION}/light"))?
+                .as_u64()
+        })
+        .filter_map(|i| {
+            staged
+                .json
+                .pointer(&format!("/extensions/{EXTENSION}/lights/{i}/name"))
+                .cloned()
+        })
+        .collect();
+    let root = root_mut(&mut staged.json, input)?;
     let mut summary = RestoreSummary {
         restored_nodes: Vec::new(),
         already_present: 0,
@@ -67,7 +83,7 @@ pub fn restore_lights(input: &Path, output: &Path, files: InputFiles) -> Result<
     };
     for (quad, light) in quads {
         let parent = parents[quad];
-        if parent.is_some_and(has_light) {
+        if parent.is_some_and(has_light) || light.get("name").is_some_and(|n| present.contains(n)) {
             summary.already_present += 1;
             continue;
         }
@@ -92,10 +108,7 @@ pub fn restore_lights(input: &Path, output: &Path, files: InputFiles) -> Result<
                 p
             }
             None => {
-                let world = world_matrix(&nodes, &parents, quad, input)?;
-                let (scale, rotation, translation) = world.to_scale_rotation_translation();
-                let mut light = light;
-                scale_light(&mut light, scale);
+                let (translation, rotation) = recorded_transform(&nodes[quad], quad, input)?;
                 let name = light.get("name").cloned().unwrap_or(json!("light"));
                 lights.push(light);
                 let index = lights.len() - 1;
@@ -146,29 +159,12 @@ fn check_light(light: &Value, quad: usize, input: &Path) -> Result<()> {
     }
 }
 
-/// A light whose quad a tool scaled (e.g. by flattening under a scaled parent) keeps its size
-/// in the world: the rectangle's height scales with local Y, its width with local X.
-fn scale_light(light: &mut Value, scale: DVec3) {
-    if (scale - DVec3::ONE).abs().max_element() < 1e-12 {
-        return;
-    }
-    let size = light["size"].as_f64().unwrap_or(1.0);
-    let aspect = light["rect"]["aspect"].as_f64().unwrap_or(1.0);
-    light["size"] = json!(size * scale.y);
-    light["rect"]["aspect"] = json!(aspect * scale.x / scale.y);
-}
-
 /// A new light node: no scale, marked as streaklight's.
-fn light_node(name: Value, index: usize, rotation: DQuat, translation: DVec3) -> Value {
-    let q = if rotation.w < 0.0 {
-        -rotation
-    } else {
-        rotation
-    };
+fn light_node(name: Value, index: usize, rotation: [f64; 4], translation: [f64; 3]) -> Value {
     json!({
         "name": name,
-        "translation": translation.to_array(),
-        "rotation": q.normalize().to_array(),
+        "translation": translation,
+        "rotation": rotation,
         "extensions": { EXTENSION: { "light": index } },
         "extras": { "streaklight": { "role": "light" } },
     })
@@ -194,48 +190,30 @@ fn parents(nodes: &[Value]) -> Vec<Option<usize>> {
     out
 }
 
-/// A node's local transform (`matrix`, or translation/rotation/scale).
-fn local_matrix(node: &Value) -> DMat4 {
-    let floats = |key: &str| -> Option<Vec<f64>> {
-        node.get(key)?
+/// The light node's world translation and rotation recorded in a fallback quad's extras.
+fn recorded_transform(
+    quad_node: &Value,
+    quad: usize,
+    input: &Path,
+) -> Result<([f64; 3], [f64; 4])> {
+    let numbers = |key: &str| -> Option<Vec<f64>> {
+        quad_node
+            .pointer(&format!("/extras/streaklight/light_node/{key}"))?
             .as_array()?
             .iter()
             .map(Value::as_f64)
             .collect()
     };
-    if let Some(m) = floats("matrix").filter(|m| m.len() == 16) {
-        return DMat4::from_cols_slice(&m);
+    let t = numbers("translation").and_then(|v| <[f64; 3]>::try_from(v).ok());
+    let r = numbers("rotation").and_then(|v| <[f64; 4]>::try_from(v).ok());
+    match (t, r) {
+        (Some(t), Some(r)) => Ok((t, r)),
+        _ => Err(Error::scene(
+            input,
+            format!(
+                "node {quad} is a fallback quad whose parent is not its light's node, and its \
+                 extras.streaklight.light_node has no translation and rotation to place the light"
+            ),
+        )),
     }
-    let t = floats("translation")
-        .filter(|v| v.len() == 3)
-        .map_or(DVec3::ZERO, |v| DVec3::from_slice(&v));
-    let r = floats("rotation")
-        .filter(|v| v.len() == 4)
-        .map_or(DQuat::IDENTITY, |v| DQuat::from_slice(&v).normalize());
-    let s = floats("scale")
-        .filter(|v| v.len() == 3)
-        .map_or(DVec3::ONE, |v| DVec3::from_slice(&v));
-    DMat4::from_scale_rotation_translation(s, r, t)
-}
-
-/// A node's world transform, through its parents.
-fn world_matrix(
-    nodes: &[Value],
-    parents: &[Option<usize>],
-    node: usize,
-    input: &Path,
-) -> Result<DMat4> {
-    let mut m = local_matrix(&nodes[node]);
-    let mut at = node;
-    for _ in 0..nodes.len() {
-        let Some(p) = parents[at] else {
-            return Ok(m);
-        };
-        m = local_matrix(&nodes[p]) * m;
-        at = p;
-    }
-    Err(Error::scene(
-        input,
-        format!("node {node}'s parents form a cycle"),
-    ))
 }
