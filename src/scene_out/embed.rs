@@ -6,10 +6,10 @@
 //! Buffer 0 keeps its bytes at offset 0, so a `.glb` input's BIN chunk is a prefix of the
 //! output's and its buffer views are untouched. Buffer `k > 0` is appended at a 4-byte
 //! aligned offset (every accessor's alignment is relative to its buffer's start, and no
-//! glTF component is wider than 4 bytes); its buffer views move by that offset. Buffer and
-//! buffer-view indices of other objects stay valid: only `buffers` shrinks to one element,
-//! and `EXT_meshopt_compression` buffer views are moved like the others.
-
+//! glTF component is wider than 4 bytes); its buffer views move by that offset, and so do
+//! the compressed views of `EXT_meshopt_compression`. An `EXT_meshopt_compression` fallback
+//! buffer (no URI, no bytes: readers decompress instead) stays a buffer of its own, after
+//! buffer 0, and its views follow it. Every other index stays valid: only `buffers` shrinks.
 use std::path::Path;
 
 use base64::Engine;
@@ -56,8 +56,16 @@ pub(crate) fn embed_all(
         .cloned()
         .unwrap_or_default();
     let mut bin = Vec::new();
-    let mut bases = Vec::with_capacity(buffers.len());
+    // Where each input buffer goes: the output buffer and the offset of its bytes in it.
+    let mut places = Vec::with_capacity(buffers.len());
+    let mut merged_json = None;
+    let mut fallbacks = Vec::new();
     for (i, buffer) in buffers.iter().enumerate() {
+        if is_meshopt_fallback(buffer) && !(i == 0 && bin_buffer0.is_some()) {
+            fallbacks.push(buffer.clone());
+            places.push(Place::Fallback(fallbacks.len() - 1));
+            continue;
+        }
         let len = byte_length(buffer, i, input)?;
         let bytes = match (&bin_buffer0, i) {
             (Some(chunk), 0) => chunk.clone(),
@@ -92,28 +100,63 @@ pub(crate) fn embed_all(
         let base = padded_len(bin.len());
         bin.resize(base, 0);
         bin.extend_from_slice(bytes);
-        bases.push(base);
+        places.push(Place::Merged(base));
+        merged_json.get_or_insert_with(|| buffer.clone());
     }
     let root = json
         .as_object_mut()
         .ok_or_else(|| Error::scene(input, "not a glTF file: the JSON is not an object"))?;
-    move_buffer_views(root, &bases, input)?;
+    if merged_json.is_none() && !fallbacks.is_empty() {
+        return Err(Error::scene(
+            input,
+            "its only buffers are EXT_meshopt_compression fallbacks: there is no compressed \
+             data to read",
+        ));
+    }
+    // The fallbacks follow buffer 0.
+    move_buffer_views(root, &places, 1, input)?;
     embed_images(root, &mut bin, &mut out, input, input_dir)?;
-    if let Some(list) = root.get_mut("buffers").and_then(Value::as_array_mut) {
-        list.truncate(1);
-        if let Some(b0) = list.first_mut().and_then(Value::as_object_mut) {
-            // shift_remove keeps the order of the other keys.
-            b0.shift_remove("uri");
-            // Untouched unless it changed: the input may spell the same number differently.
-            if b0.get("byteLength").and_then(Value::as_u64) != Some(bin.len() as u64) {
-                b0.insert("byteLength".into(), Value::from(bin.len()));
-            }
-        }
-        if !list.is_empty() {
-            out.bin = Some(bin);
+    // Images embedded into a document without buffers made an empty buffer 0.
+    let merged_json = merged_json.or_else(|| {
+        root.get("buffers")
+            .and_then(|b| b.get(0))
+            .filter(|_| buffers.is_empty())
+            .cloned()
+    });
+    let Some(mut merged) = merged_json else {
+        return Ok(out);
+    };
+    if let Some(b0) = merged.as_object_mut() {
+        // shift_remove keeps the order of the other keys.
+        b0.shift_remove("uri");
+        // Untouched unless it changed: the input may spell the same number differently.
+        if b0.get("byteLength").and_then(Value::as_u64) != Some(bin.len() as u64) {
+            b0.insert("byteLength".into(), Value::from(bin.len()));
         }
     }
+    let mut list = vec![merged];
+    list.extend(fallbacks);
+    root.insert("buffers".into(), Value::Array(list));
+    out.bin = Some(bin);
     Ok(out)
+}
+
+/// Where an input buffer's bytes go in a `.glb` output.
+#[derive(Clone, Copy)]
+enum Place {
+    /// Into buffer 0, at this offset.
+    Merged(usize),
+    /// A meshopt fallback buffer: the `k`th after the merged buffer 0.
+    Fallback(usize),
+}
+
+/// An `EXT_meshopt_compression` fallback buffer: no URI, and no bytes that any reader loads.
+pub(crate) fn is_meshopt_fallback(buffer: &Value) -> bool {
+    buffer.get("uri").is_none()
+        && buffer
+            .pointer("/extensions/EXT_meshopt_compression/fallback")
+            .and_then(Value::as_bool)
+            == Some(true)
 }
 
 /// `byteLength` of buffer `i`.
@@ -160,8 +203,14 @@ pub(crate) fn uri_bytes(
         .map_err(|e| Error::scene(input, format!("{what}'s file {}: {e}", path.display())))
 }
 
-/// Points every buffer view of buffer `k` at buffer 0, `bases[k]` further on.
-fn move_buffer_views(root: &mut Map<String, Value>, bases: &[usize], input: &Path) -> Result<()> {
+/// Points every buffer view at the output buffer holding its input buffer's bytes
+/// (`places`), fallback buffers numbered from `fallback_base`.
+fn move_buffer_views(
+    root: &mut Map<String, Value>,
+    places: &[Place],
+    fallback_base: usize,
+    input: &Path,
+) -> Result<()> {
     let Some(views) = root.get_mut("bufferViews").and_then(Value::as_array_mut) else {
         return Ok(());
     };
@@ -169,26 +218,32 @@ fn move_buffer_views(root: &mut Map<String, Value>, bases: &[usize], input: &Pat
         let Some(view) = view.as_object_mut() else {
             continue;
         };
-        move_view(view, bases, input, v)?;
+        move_view(view, places, fallback_base, input, v)?;
         if let Some(meshopt) = view
             .get_mut("extensions")
             .and_then(|e| e.get_mut(MESHOPT))
             .and_then(Value::as_object_mut)
         {
-            move_view(meshopt, bases, input, v)?;
+            move_view(meshopt, places, fallback_base, input, v)?;
         }
     }
     Ok(())
 }
 
 /// Moves one `{buffer, byteOffset}` object.
-fn move_view(view: &mut Map<String, Value>, bases: &[usize], input: &Path, v: usize) -> Result<()> {
+fn move_view(
+    view: &mut Map<String, Value>,
+    places: &[Place],
+    fallback_base: usize,
+    input: &Path,
+    v: usize,
+) -> Result<()> {
     let Some(buffer) = view.get("buffer").and_then(Value::as_u64) else {
         return Ok(());
     };
-    let base = usize::try_from(buffer)
+    let place = usize::try_from(buffer)
         .ok()
-        .and_then(|b| bases.get(b))
+        .and_then(|b| places.get(b))
         .copied()
         .ok_or_else(|| {
             Error::scene(
@@ -196,12 +251,17 @@ fn move_view(view: &mut Map<String, Value>, bases: &[usize], input: &Path, v: us
                 format!("buffer view {v} names buffer {buffer}, which does not exist"),
             )
         })?;
-    if buffer == 0 {
-        return Ok(());
+    let (to, base) = match place {
+        Place::Merged(base) => (0, base),
+        Place::Fallback(k) => (fallback_base + k, 0),
+    };
+    if to as u64 != buffer {
+        view.insert("buffer".into(), Value::from(to));
     }
-    let offset = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0);
-    view.insert("buffer".into(), Value::from(0));
-    view.insert("byteOffset".into(), Value::from(offset + base as u64));
+    if base > 0 {
+        let offset = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0);
+        view.insert("byteOffset".into(), Value::from(offset + base as u64));
+    }
     Ok(())
 }
 

@@ -197,6 +197,7 @@ pub(crate) fn append(
                     "light_node": {
                         "translation": light.translation,
                         "rotation": light.rotation,
+                        "wall_offset": light.offset,
                     },
                 } },
             }),

@@ -110,14 +110,13 @@ pub fn restore_lights(input: &Path, output: &Path, files: InputFiles) -> Result<
             None => {
                 let (translation, rotation) = recorded_transform(&nodes[quad], quad, input)?;
                 let name = light.get("name").cloned().unwrap_or(json!("light"));
+                let offset = nodes[quad].pointer("/extras/streaklight/light_node/wall_offset");
+                let mut node = light_node(name, lights.len(), rotation, translation);
+                if let Some(offset) = offset.filter(|o| o.is_number()) {
+                    node["extras"]["streaklight"]["wall_offset"] = offset.clone();
+                }
                 lights.push(light);
-                let index = lights.len() - 1;
-                let node = push(
-                    root,
-                    "nodes",
-                    light_node(name, index, rotation, translation),
-                    input,
-                )?;
+                let node = push(root, "nodes", node, input)?;
                 let scene = target_scene(root, input)?;
                 if let Some(list) = root
                     .get_mut("scenes")

@@ -242,11 +242,14 @@ pub(crate) fn bin_chunk_buffer(doc: &Document, input: &Path) -> Result<Option<Ve
         if let Some(i) = buffers
             .into_iter()
             .flatten()
-            .position(|b| b.get("uri").is_none())
+            .position(|b| b.get("uri").is_none() && !embed::is_meshopt_fallback(b))
         {
             return Err(Error::scene(
                 input,
-                format!("buffer {i} has no \"uri\"; in a .gltf file every buffer needs one"),
+                format!(
+                    "buffer {i} has no \"uri\"; in a .gltf file every buffer needs one \
+                     (but an EXT_meshopt_compression fallback)"
+                ),
             ));
         }
         return Ok(None);
