@@ -3,11 +3,10 @@
 Import: every node with an ``EXT_lights_area`` rectangle light gets a Blender area light
 (shape RECTANGLE) as a child: width ``size * rect.aspect`` along the node's X, height ``size``
 along its Y, emitting along its -Z, colour ``color``, power ``pi * width * height *
-intensity`` watts. Cycles gives an area light of power P and area A the radiance
-P / (pi A) (``intern/cycles/scene/light.cpp``: an area light's strength is multiplied by
-``invarea * M_1_PI_F``), so the light's radiance in the render is ``color * intensity``, the
-radiance streaklight fitted (an emissive surface of strength ``intensity`` has that radiance
-too). streaklight's emissive fallback quads are hidden from rendering when their light was
+intensity`` watts: the flux of a Lambertian rectangle of radiance L and area A is P = pi A L,
+and a Blender area light's power is the flux it emits, so the light's radiance in a render is
+``color * intensity``, the radiance streaklight fitted (an emissive surface of strength
+``intensity`` has that radiance too). streaklight's emissive fallback quads are hidden from rendering when their light was
 imported (they stay visible in the viewport).
 
 Export: every rectangle (or square) area light is written back as an ``EXT_lights_area``

@@ -1,13 +1,14 @@
 // Runs a streaklight output through the real glTF-Transform CLI with this package's config
 // (`copy`, `dedup`, `prune`, `optimize --simplify false`) and checks that every light, every
 // light node's transform and extension, and every fallback quad come out identical. Also
-// writes `stock-copy.gltf`: `copy` without the config, which drops the lights (for the
-// restore-lights test).
+// writes `stock-copy/stock-copy.gltf`: `copy` without the config, which drops the lights.
+// Each output gets a folder of its own (OUT_DIR/COMMAND/COMMAND.gltf): glTF-Transform writes
+// buffers under the names they had, so outputs sharing a folder would overwrite each other's.
 //
 // usage: node test/pipeline.mjs IN.gltf OUT_DIR   (prints one line per check; exit 1 on failure)
 
 import { execFileSync } from 'node:child_process';
-import { readFileSync } from 'node:fs';
+import { mkdirSync, readFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { isDeepStrictEqual } from 'node:util';
@@ -49,7 +50,8 @@ if (!want.lights || Object.keys(want.nodes).length === 0) {
   process.exit(1);
 }
 for (const command of [['copy'], ['dedup'], ['prune'], ['optimize', '--simplify', 'false']]) {
-  const out = join(outDir, `${command[0]}.gltf`);
+  mkdirSync(join(outDir, command[0]), { recursive: true });
+  const out = join(outDir, command[0], `${command[0]}.gltf`);
   run([command[0], input, out, ...command.slice(1), '--config', config]);
   const got = lightsOf(read(out));
   if (isDeepStrictEqual(got, want)) {
@@ -59,7 +61,8 @@ for (const command of [['copy'], ['dedup'], ['prune'], ['optimize', '--simplify'
     console.log(`FAILED: ${command.join(' ')} changed the lights -> ${out}\nwant ${JSON.stringify(want)}\ngot  ${JSON.stringify(got)}`);
   }
 }
-const stock = join(outDir, 'stock-copy.gltf');
+mkdirSync(join(outDir, 'stock-copy'), { recursive: true });
+const stock = join(outDir, 'stock-copy', 'stock-copy.gltf');
 run(['copy', input, stock]);
 const stripped = lightsOf(read(stock));
 if (stripped.lights !== null || stripped.used) {
