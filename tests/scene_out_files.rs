@@ -476,3 +476,91 @@ fn a_failed_scene_write_leaves_no_stray_bin() {
     assert!(leftovers.is_empty());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `doc` without `EXT_lights_area` anywhere, as a tool without the extension writes it.
+fn strip_lights(doc: &mut Value) {
+    doc["extensions"]
+        .as_object_mut()
+        .unwrap()
+        .remove("EXT_lights_area");
+    doc["extensionsUsed"]
+        .as_array_mut()
+        .unwrap()
+        .retain(|e| e != "EXT_lights_area");
+    for node in doc["nodes"].as_array_mut().unwrap() {
+        if let Some(ext) = node.get_mut("extensions").and_then(Value::as_object_mut) {
+            ext.remove("EXT_lights_area");
+        }
+    }
+}
+
+/// (light JSON, node translation, node rotation) of every light, by light name.
+fn lights_by_name(path: &Path) -> Vec<(String, Value, Value, Value)> {
+    let json = load(path).json;
+    let mut out: Vec<_> = json["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| {
+            let i = n["extensions"]["EXT_lights_area"]["light"].as_u64()? as usize;
+            let light = json["extensions"]["EXT_lights_area"]["lights"][i].clone();
+            let name = light["name"].as_str().unwrap().to_string();
+            Some((name, light, n["translation"].clone(), n["rotation"].clone()))
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+#[test]
+fn restore_lights_rebuilds_dropped_lights_from_the_quads() {
+    let dir = temp_dir("restore");
+    let input = generated_inputs(&dir.join("in")).remove(0);
+    let lit = dir.join("lit.gltf");
+    let s = write_lit_scene(&input, &lit, &two_lights(), &WriteOptions::default()).unwrap();
+    let want = lights_by_name(&lit);
+    // The existing light of the input has no quad: only the two written ones can come back.
+    assert_eq!(want.len(), 3);
+    let want: Vec<_> = want.into_iter().filter(|l| l.0 != "existing").collect();
+    let mut stripped = load(&lit).json;
+    strip_lights(&mut stripped);
+    // Hierarchy kept: the lights go back on their old nodes.
+    let kept = dir.join("kept.gltf");
+    std::fs::write(&kept, serde_json::to_vec(&stripped).unwrap()).unwrap();
+    // Hierarchy flattened: the quads at the scene's root, the light nodes gone from it.
+    let mut flat = stripped.clone();
+    for &n in &s.node_indices {
+        flat["nodes"][n].as_object_mut().unwrap().remove("children");
+    }
+    let scene_nodes = flat["scenes"][s.scene_index]["nodes"]
+        .as_array_mut()
+        .unwrap();
+    scene_nodes.retain(|n| !s.node_indices.contains(&(n.as_u64().unwrap() as usize)));
+    scene_nodes.extend(s.fallback_node_indices.iter().map(|&q| json!(q)));
+    let flattened = dir.join("flat.gltf");
+    std::fs::write(&flattened, serde_json::to_vec(&flat).unwrap()).unwrap();
+    for (from, on_old_nodes) in [(&kept, true), (&flattened, false)] {
+        for ext in ["gltf", "glb"] {
+            let out = from.with_extension(format!("restored.{ext}"));
+            let r = streaklight::scene_out::restore_lights(from, &out, InputFiles::Copy).unwrap();
+            assert_eq!(r.already_present, 0);
+            assert_eq!(
+                r.restored_nodes == s.node_indices,
+                on_old_nodes,
+                "{}",
+                out.display()
+            );
+            let got = lights_by_name(&out);
+            let got: Vec<_> = got.into_iter().filter(|l| l.0 != "existing").collect();
+            assert_eq!(got, want, "{}", out.display());
+            assert_self_contained(&out);
+            assert!(validator_problems(&out).is_empty(), "{}", out.display());
+        }
+    }
+    // Nothing to restore: every light is there.
+    let again = dir.join("again.gltf");
+    let r = streaklight::scene_out::restore_lights(&lit, &again, InputFiles::Copy).unwrap();
+    assert_eq!((r.restored_nodes.len(), r.already_present), (0, 2));
+    assert_eq!(lights_by_name(&again).len(), 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

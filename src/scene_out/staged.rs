@@ -78,6 +78,12 @@ pub(crate) fn stage(input: &Path, output: &Path, files: InputFiles) -> Result<St
     let local = resources::local_resources(&json, &input_dir);
     let mut inputs = vec![input.to_path_buf()];
     inputs.extend(local.iter().map(|r| r.path.clone()));
+    // Before any work: the output itself must not be an input (the files beside it are
+    // checked when they are known, in `write`).
+    ensure_not_an_input(
+        output,
+        &inputs.iter().map(PathBuf::as_path).collect::<Vec<_>>(),
+    )?;
     let mut staged = Staged {
         json: Value::Null,
         format,
