@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use common::gltf_check::load;
+use common::gltf_check::{lights_by_name, load};
 use common::validator::{assert_validator_clean, validator_errors, validator_problems};
 use serde_json::Value;
 use streaklight::convert::{convert, ConvertOptions};
@@ -136,36 +136,6 @@ fn gltf_transform_keeps_every_light_and_never_writes_into_the_input() {
     assert_eq!(bytes_of(&water), before, "the input's water.bin changed");
 }
 
-/// The lights of a document: (name, light JSON, node translation, node rotation).
-fn lights_of(path: &Path) -> Vec<(String, Value, Vec<f64>, Vec<f64>)> {
-    let json = load(path).json;
-    let lights = &json["extensions"]["EXT_lights_area"]["lights"];
-    let floats = |v: &Value| -> Vec<f64> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect()
-    };
-    let mut out: Vec<_> = json["nodes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|n| {
-            let i = n["extensions"]["EXT_lights_area"]["light"].as_u64()? as usize;
-            let light = lights[i].clone();
-            Some((
-                light["name"].as_str().unwrap().to_string(),
-                light,
-                floats(&n["translation"]),
-                floats(&n["rotation"]),
-            ))
-        })
-        .collect();
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    out
-}
-
 #[test]
 fn restore_lights_brings_back_what_stock_gltf_transform_dropped() {
     let f = fit();
@@ -174,7 +144,7 @@ fn restore_lights_brings_back_what_stock_gltf_transform_dropped() {
     let cli = Path::new(ROOT)
         .join("integrations/gltf-transform/node_modules/@gltf-transform/cli/bin/cli.js");
     let install = "install Node.js and run `npm ci --prefix integrations/gltf-transform`";
-    let want = lights_of(&f.lit);
+    let want = lights_by_name(&f.lit);
     assert_eq!(want.len(), 2);
     for command in ["copy", "optimize"] {
         // A folder each: glTF-Transform writes buffers under the names they had, so two of
@@ -188,14 +158,14 @@ fn restore_lights_brings_back_what_stock_gltf_transform_dropped() {
         }
         run("node", &args, install);
         assert!(
-            lights_of(&stripped).is_empty(),
+            lights_by_name(&stripped).is_empty(),
             "stock {command} kept the lights"
         );
         for ext in ["gltf", "glb"] {
             let restored = work.join(format!("restored-{command}.{ext}"));
             let summary = restore_lights(&stripped, &restored, InputFiles::Copy).unwrap();
             assert_eq!(summary.restored_nodes.len(), 2, "{command} -> {ext}");
-            let got = lights_of(&restored);
+            let got = lights_by_name(&restored);
             assert_eq!(got.len(), want.len());
             for (g, w) in got.iter().zip(&want) {
                 // JavaScript writes 1.0 as 1: compare the values, not their spelling.
@@ -230,7 +200,7 @@ fn restore_lights_brings_back_what_stock_gltf_transform_dropped() {
         (summary.restored_nodes.len(), summary.already_present),
         (0, 2)
     );
-    assert_eq!(lights_of(&again), want);
+    assert_eq!(lights_by_name(&again), want);
 }
 
 #[test]

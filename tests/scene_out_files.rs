@@ -12,7 +12,7 @@ mod common;
 
 use common::dirs::{sorted_paths, temp_dir};
 use common::gltf_builder::glb;
-use common::gltf_check::{assert_same_data, load, resolve};
+use common::gltf_check::{assert_same_data, lights_by_name, load, resolve};
 use common::scene_out_case::{generated_inputs, triangle_bytes, two_lights};
 use common::scene_out_checks::{assert_self_contained, check_output};
 use common::validator::{assert_validator_clean, validator_problems};
@@ -492,24 +492,6 @@ fn strip_lights(doc: &mut Value) {
             ext.remove("EXT_lights_area");
         }
     }
-}
-
-/// (light JSON, node translation, node rotation) of every light, by light name.
-fn lights_by_name(path: &Path) -> Vec<(String, Value, Value, Value)> {
-    let json = load(path).json;
-    let mut out: Vec<_> = json["nodes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|n| {
-            let i = n["extensions"]["EXT_lights_area"]["light"].as_u64()? as usize;
-            let light = json["extensions"]["EXT_lights_area"]["lights"][i].clone();
-            let name = light["name"].as_str().unwrap().to_string();
-            Some((name, light, n["translation"].clone(), n["rotation"].clone()))
-        })
-        .collect();
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    out
 }
 
 #[test]

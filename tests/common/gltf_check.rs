@@ -247,3 +247,34 @@ pub fn assert_keeps_everything(input: &Path, output: &Path) {
         "extensionsRequired must not change"
     );
 }
+
+/// Every `EXT_lights_area` light on a node of the document at `path`: (light name, light
+/// object, node translation, node rotation; empty when the node has none), sorted by name.
+pub fn lights_by_name(path: &Path) -> Vec<(String, Value, Vec<f64>, Vec<f64>)> {
+    let json = load(path).json;
+    let floats = |v: &Value| -> Vec<f64> {
+        v.as_array()
+            .into_iter()
+            .flatten()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let mut out: Vec<_> = json["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| {
+            let i = n["extensions"]["EXT_lights_area"]["light"].as_u64()? as usize;
+            let light = json["extensions"]["EXT_lights_area"]["lights"][i].clone();
+            let name = light["name"].as_str().unwrap().to_string();
+            Some((
+                name,
+                light,
+                floats(&n["translation"]),
+                floats(&n["rotation"]),
+            ))
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
