@@ -13,7 +13,7 @@ use crate::pipeline::{self, light_name, FitSettings, Input};
 use crate::progress::Reporter;
 use crate::report::{self, Files, Report};
 use crate::scene_in::{self, AreaLight, LoadOptions, Scene};
-use crate::scene_out::{self, LightToWrite, WriteOptions};
+use crate::scene_out::{self, InputFiles, LightToWrite, WriteOptions};
 use crate::settings::{reword, Setting};
 use crate::{debug_pictures, output_file, Error, Result};
 
@@ -40,6 +40,10 @@ pub struct ConvertOptions<'a> {
     pub fit: FitSettings,
     /// Write emissive fallback quads under the lights.
     pub fallback_quads: bool,
+    /// Metres each light's node sits in front of its wall ([`WriteOptions::light_offset`]).
+    pub light_offset: f64,
+    /// Where a `.gltf` output finds the input's files ([`WriteOptions::input_files`]).
+    pub input_files: InputFiles,
     /// Succeed (writing the scene unchanged) when no light is found.
     pub allow_empty: bool,
     /// Told as each stage of the run starts (silent by default).
@@ -68,6 +72,8 @@ impl ConvertOptions<'_> {
             exposure: 1.0,
             fit: FitSettings::default(),
             fallback_quads: true,
+            light_offset: scene_out::DEFAULT_LIGHT_OFFSET,
+            input_files: InputFiles::Copy,
             allow_empty: false,
             progress: Reporter::default(),
             wording: |s| s.to_string(),
@@ -112,6 +118,12 @@ pub fn check_output(options: &ConvertOptions) -> Result<()> {
             &options.output,
             "the output must end in .gltf or .glb",
         ));
+    }
+    if !(options.light_offset.is_finite() && options.light_offset >= 0.0) {
+        return Err(Error::Usage(format!(
+            "the light offset must be a number of metres >= 0, not {}",
+            options.light_offset
+        )));
     }
     let inputs = [options.scene.as_path(), options.photo.as_path()];
     output_file::ensure_not_an_input(&options.output, &inputs)?;
@@ -253,14 +265,14 @@ pub fn convert_loaded(
             &WriteOptions {
                 fallback_quads: options.fallback_quads,
                 nits_scale: options.load.nits_scale,
+                light_offset: options.light_offset,
+                input_files: options.input_files,
             },
         )
     })?;
-    let mut files_written = vec![options.output.clone()];
-    let bin = options.output.with_extension("streaklight.bin");
-    if bin.is_file() && options.output.extension().is_some_and(|e| e != "glb") {
-        files_written.push(bin);
-    }
+    lit.warnings
+        .extend(summary.resources.warnings.iter().cloned());
+    let mut files_written = summary.resources.files_written.clone();
     let mut report = report::build(
         scene,
         &lit,
@@ -276,7 +288,9 @@ pub fn convert_loaded(
     for (k, r) in report.lights.iter_mut().enumerate() {
         r.light_index = summary.light_indices.get(k).copied();
         r.node_index = summary.node_indices.get(k).copied();
+        r.node_translation = summary.node_translations.get(k).copied();
     }
+    report.settings.light_offset = Some(options.light_offset);
     if let Some(dir) = &options.debug_dir {
         // After the report is built: the pictures' index shows its numbers.
         progress.stage("debug pictures");

@@ -38,6 +38,10 @@ pub enum Command {
     /// Render the water and the EXT_lights_area lights of a scene as its camera sees them.
     #[command(allow_negative_numbers = true, after_help = cli::exit::OTHER_HELP)]
     Render(cli::render::Args),
+    /// Put back the EXT_lights_area lights of a fit output from its fallback quads, after a
+    /// tool without the extension dropped them.
+    #[command(after_help = cli::exit::OTHER_HELP)]
+    RestoreLights(cli::restore_lights::Args),
     /// Write the sample scenes of the paper's setup and render their photos.
     #[command(after_help = cli::exit::OTHER_HELP)]
     Samples(cli::samples::Args),
@@ -55,6 +59,7 @@ fn main() -> ExitCode {
         Command::Render(args) => Exit::of(cli::render::run(args, &out)),
         Command::Samples(args) => Exit::of(cli::samples::run(args, &out)),
         Command::Completions(args) => Exit::of(cli::completions::run::<Cli>(args)),
+        Command::RestoreLights(args) => Exit::of(cli::restore_lights::run(args, &out)),
     };
     exit.code()
 }

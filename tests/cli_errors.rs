@@ -162,3 +162,58 @@ fn render_refuses_bad_scenes_clearly() {
         );
     }
 }
+
+#[test]
+fn restore_lights_refuses_bad_input_clearly() {
+    let dir = common::temp_dir("cli-restore");
+    let out = dir.join("out.gltf");
+    let o = out.to_str().unwrap();
+    let path = |n: &str| dir.join(n).to_str().unwrap().to_owned();
+    expect_failure(
+        &["restore-lights", &path("missing.gltf"), "-o", o],
+        &["missing.gltf", "No such file"],
+        &out,
+    );
+    // No fallback quad to read the lights from.
+    common::paper_setup(None).write_gltf(&dir.join("plain.gltf"));
+    expect_failure(
+        &["restore-lights", &path("plain.gltf"), "-o", o],
+        &["plain.gltf", "nothing to restore"],
+        &out,
+    );
+    // A quad whose recorded light is not a rectangle, or has no transform to put it at.
+    let mut bad = common::paper_setup(None);
+    bad.json["nodes"].as_array_mut().unwrap().push(json!({
+        "name": "quad",
+        "extras": { "streaklight": { "role": "fallback-quad", "light": { "type": "disk" } } }
+    }));
+    bad.write_gltf(&dir.join("bad.gltf"));
+    expect_failure(
+        &["restore-lights", &path("bad.gltf"), "-o", o],
+        &["bad.gltf", "not a rect light"],
+        &out,
+    );
+    let mut lost = bad;
+    let quad = lost.json["nodes"].as_array().unwrap().len() - 1;
+    lost.json["nodes"][quad]["extras"]["streaklight"]["light"] = json!({
+        "type": "rect", "color": [1.0, 1.0, 1.0], "intensity": 1.0, "size": 1.0,
+        "rect": { "aspect": 1.0 }, "name": "l"
+    });
+    lost.write_gltf(&dir.join("lost.gltf"));
+    expect_failure(
+        &["restore-lights", &path("lost.gltf"), "-o", o],
+        &["lost.gltf", "translation and rotation"],
+        &out,
+    );
+    // Never over the input.
+    let input = dir.join("lost.gltf");
+    let before = std::fs::read(&input).unwrap();
+    let (ok, _, stderr) = common::run_cli(&[
+        "restore-lights",
+        &path("lost.gltf"),
+        "-o",
+        &path("lost.gltf"),
+    ]);
+    assert!(!ok && stderr.contains("input"), "{stderr}");
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+}

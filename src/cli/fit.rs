@@ -11,6 +11,7 @@ use super::exit::{exit_codes, Exit};
 use super::fit_batch::{jobs, Outputs};
 use super::json::Summary;
 use super::output::Output;
+use super::output_args::OutputArgs;
 use super::scene_args::SceneArgs;
 use super::streak_args::StreakArgs;
 
@@ -122,6 +123,14 @@ pub struct Args {
     /// either way.
     #[arg(long)]
     pub no_direct_view: bool,
+    /// How far in front of its wall each light is written, in metres, along the direction it
+    /// emits: a light exactly in the wall's plane is shadowed by the wall in renderers that
+    /// trace shadow rays (Blender's Cycles among them). The report records it.
+    #[arg(long, value_name = "METRES", default_value_t = streaklight::scene_out::DEFAULT_LIGHT_OFFSET)]
+    pub light_offset: f64,
+    /// Output-file options.
+    #[command(flatten)]
+    pub files: OutputArgs,
     /// Succeed and write the scene unchanged when no light is found.
     #[arg(long)]
     pub allow_empty: bool,
@@ -210,6 +219,8 @@ fn fit_all(args: &Args, out: &Output, summary: &mut Summary) -> streaklight::Res
         }),
         exposure: args.exposure,
         fallback_quads: !args.no_fallback_quads,
+        light_offset: args.light_offset,
+        input_files: args.files.input_files(),
         allow_empty: args.allow_empty,
         progress: out.progress(),
         wording: super::flags::flag,

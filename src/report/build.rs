@@ -70,6 +70,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             }),
             exposure: run.exposure,
             nits_scale: run.nits_scale,
+            light_offset: None,
             method: settings.method.name().into(),
             camera: scene.camera.name.clone(),
             water: scene.water.name.clone(),
@@ -171,6 +172,7 @@ pub fn light_report(
         direct_pixels: uncertainty.map(|u| u.direct_pixels),
         light_index: None,
         node_index: None,
+        node_translation: None,
     }
 }
 

@@ -81,6 +81,9 @@ pub struct Settings {
     pub exposure: f32,
     /// Intensity units per unit of radiance in the written lights.
     pub nits_scale: f64,
+    /// How far (metres) each light's node was written in front of its fitted rectangle,
+    /// along its normal, off its wall (`None` when no scene was written).
+    pub light_offset: Option<f64>,
     /// Fitting method.
     pub method: String,
     /// Camera node used.
@@ -125,6 +128,9 @@ pub struct LightReport {
     pub light_index: Option<usize>,
     /// Index of the light's node in the output.
     pub node_index: Option<usize>,
+    /// The translation of the light's node in the output: `center` moved
+    /// `settings.light_offset` along the plane's normal.
+    pub node_translation: Option<[f64; 3]>,
 }
 
 /// One-sigma uncertainties of a light's parameters, from the joint fit's full covariance of

@@ -188,7 +188,18 @@ pub(crate) fn append(
             json!({
                 "name": label,
                 "mesh": mesh,
-                "extras": { "streaklight": { "role": "fallback-quad" } },
+                // What restore-lights needs to rebuild the light from the quad alone: the
+                // light object and its node's transform in the world. Tools that drop the
+                // extension may flatten, move or requantise the quad itself.
+                "extras": { "streaklight": {
+                    "role": "fallback-quad",
+                    "light": super::lights::light_json(light),
+                    "light_node": {
+                        "translation": light.translation,
+                        "rotation": light.rotation,
+                        "wall_offset": light.offset,
+                    },
+                } },
             }),
             input,
         )?);
@@ -213,6 +224,7 @@ mod tests {
             color: [1.0; 3],
             intensity: 1.0,
             streak: None,
+            offset: 0.0,
         };
         let c = corners(&light).map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
         for t in INDICES.chunks(3) {

@@ -28,13 +28,17 @@ pub(crate) struct PreparedLight {
     /// Largest radiance component times the nits scale.
     pub intensity: f64,
     pub streak: Option<usize>,
+    /// How far the node sits in front of the fitted rectangle (metres, along `normal`).
+    pub offset: f64,
 }
 
-/// Checks `light` and converts it; `index` is its position in the caller's list, for messages.
+/// Checks `light` and converts it, its node `offset` metres in front of it; `index` is its
+/// position in the caller's list, for messages.
 pub(crate) fn prepare(
     light: &LightToWrite,
     index: usize,
     nits_scale: f64,
+    offset: f64,
 ) -> Result<PreparedLight> {
     let bad = |msg: String| {
         Error::Usage(format!(
@@ -75,13 +79,14 @@ pub(crate) fn prepare(
     };
     Ok(PreparedLight {
         name: light.name.clone(),
-        translation: light.center.to_array(),
+        translation: (light.center + light.normal * offset).to_array(),
         rotation: rotation(light.normal, light.up),
         width: light.width,
         height: light.height,
         color,
         intensity: max * nits_scale,
         streak: light.streak_id,
+        offset,
     })
 }
 
@@ -115,7 +120,7 @@ pub(crate) fn light_json(light: &PreparedLight) -> Value {
 /// The node that places light `light_index`: at the scene root, no scale, marked so the scene
 /// loader and later runs know it is ours.
 pub(crate) fn node_json(light: &PreparedLight, light_index: usize, child: Option<usize>) -> Value {
-    let mut marker = json!({ "role": "light" });
+    let mut marker = json!({ "role": "light", "wall_offset": light.offset });
     if let Some(streak) = light.streak {
         marker["streak"] = Value::from(streak);
     }
@@ -153,7 +158,7 @@ mod tests {
     fn rotation_maps_local_axes_to_the_light_frame() {
         let normal = DVec3::new(1.0, -1.0, 0.5).normalize();
         let up = normal.any_orthonormal_vector();
-        let p = prepare(&light(normal, up), 0, 1.0).unwrap();
+        let p = prepare(&light(normal, up), 0, 1.0, 0.0).unwrap();
         let q = DQuat::from_array(p.rotation);
         assert!((q * DVec3::NEG_Z - normal).length() < 1e-12);
         assert!((q * DVec3::Y - up).length() < 1e-12);
@@ -164,6 +169,7 @@ mod tests {
             &light(DVec3::new(0.0, -0.6, 0.8), DVec3::new(0.0, 0.8, 0.6)),
             0,
             1.0,
+            0.0,
         );
         assert!(half
             .unwrap()
@@ -173,31 +179,44 @@ mod tests {
     }
 
     #[test]
+    fn the_node_sits_the_offset_in_front_of_the_rectangle() {
+        let normal = DVec3::new(0.0, -0.6, 0.8);
+        let l = light(normal, DVec3::new(0.0, 0.8, 0.6));
+        let p = prepare(&l, 0, 1.0, 0.001).unwrap();
+        let moved = DVec3::from_array(p.translation) - l.center;
+        assert!((moved - normal * 0.001).length() < 1e-15, "{moved}");
+        assert_eq!(
+            node_json(&p, 0, None)["extras"]["streaklight"]["wall_offset"],
+            0.001
+        );
+    }
+
+    #[test]
     fn identity_frame_is_the_identity_quaternion() {
-        let p = prepare(&light(DVec3::NEG_Z, DVec3::Y), 0, 1.0).unwrap();
+        let p = prepare(&light(DVec3::NEG_Z, DVec3::Y), 0, 1.0, 0.0).unwrap();
         assert_eq!(p.rotation, [0.0, 0.0, 0.0, 1.0]);
     }
 
     #[test]
     fn colour_is_normalised_and_intensity_scaled() {
-        let p = prepare(&light(DVec3::NEG_Z, DVec3::Y), 0, 683.0).unwrap();
+        let p = prepare(&light(DVec3::NEG_Z, DVec3::Y), 0, 683.0, 0.0).unwrap();
         assert_eq!(p.color, [1.0, 0.5, 0.0]);
         assert_eq!(p.intensity, 4.0 * 683.0);
         let mut dark = light(DVec3::NEG_Z, DVec3::Y);
         dark.radiance = [0.0; 3];
-        let p = prepare(&dark, 0, 1.0).unwrap();
+        let p = prepare(&dark, 0, 1.0, 0.0).unwrap();
         assert_eq!((p.color, p.intensity), ([1.0; 3], 0.0));
     }
 
     #[test]
     fn refuses_bad_frames_and_sizes() {
-        assert!(prepare(&light(DVec3::NEG_Z, DVec3::Z), 0, 1.0).is_err());
-        assert!(prepare(&light(DVec3::new(0.0, 0.0, -2.0), DVec3::Y), 0, 1.0).is_err());
+        assert!(prepare(&light(DVec3::NEG_Z, DVec3::Z), 0, 1.0, 0.0).is_err());
+        assert!(prepare(&light(DVec3::new(0.0, 0.0, -2.0), DVec3::Y), 0, 1.0, 0.0).is_err());
         let mut l = light(DVec3::NEG_Z, DVec3::Y);
         l.height = 0.0;
-        assert!(prepare(&l, 0, 1.0).is_err());
+        assert!(prepare(&l, 0, 1.0, 0.0).is_err());
         l.height = 1.0;
         l.radiance[1] = f64::NAN;
-        assert!(prepare(&l, 0, 1.0).is_err());
+        assert!(prepare(&l, 0, 1.0, 0.0).is_err());
     }
 }

@@ -1,48 +1,38 @@
 //! Step 10 of the pipeline (method §5, §7): write the fitted lights into the user's glTF,
-//! losslessly.
+//! losslessly, as a self-contained output.
 //!
 //! The document is edited as JSON: every existing key, value and index stays as it was, and
 //! new objects are appended (`extensionsUsed`, the top-level `EXT_lights_area.lights`, nodes
 //! added to the scene, and for the fallback quads buffer views, accessors, materials and
 //! meshes). Existing binary data is never rewritten; new data is appended after it.
 //!
-//! Where the new binary data goes:
-//!
-//! | input | output | new data |
-//! |---|---|---|
-//! | `.glb` with a BIN chunk | `.glb` | appended to the BIN chunk (buffer 0 grows) |
-//! | `.glb` with a BIN chunk | `.gltf` | the BIN chunk + new data become `<out>.streaklight.bin`, buffer 0's `uri` |
-//! | buffer 0 is a `data:` URI | `.glb` | buffer 0's bytes move into the BIN chunk (its `uri` is dropped), new data appended |
-//! | no buffers | `.glb` | a new BIN chunk, new buffer 0 |
-//! | buffer 0 is an external file | `.glb` | a new buffer, external file `<out>.streaklight.bin` |
-//! | no BIN-chunk buffer | `.gltf` | a new buffer, external file `<out>.streaklight.bin` |
-//!
-//! A `data:` URI is never used for new data: the glTF-Validator warns about `data:` URIs in a
-//! GLB (`DATA_URI_GLB`), and in a `.gltf` a base64 copy is a third larger than the file. Only
-//! buffer 0 can live in the BIN chunk (GLB spec), so the input's other `data:` buffers and
-//! images stay as they are, and a `.glb` written from such a `.gltf` keeps those warnings.
-//!
-//! When the output goes to another folder than the input, relative buffer and image URIs are
-//! rewritten to reach the original files (see the `resources` module); nothing is copied.
+//! The output needs nothing outside its own folder (`staged`): a `.glb` holds every buffer
+//! and image in its BIN chunk (`embed`), a `.gltf` gets copies of the input's files beside it
+//! under names made from its own (`side_files`), unless [`InputFiles::Reference`] asks to
+//! refer to them where they are. Only the container's storage changes: for a `.glb`, the
+//! buffers merge into buffer 0 and images become buffer views; for a `.gltf`, URIs name the
+//! copies. Every value read through them is the same.
 
 mod document;
 mod edit;
+mod embed;
 mod fallback_quad;
 mod lights;
 mod resources;
+mod restore;
+mod side_files;
+mod staged;
 
 use std::path::{Path, PathBuf};
 
-use base64::Engine;
 use glam::DVec3;
 use serde_json::{json, Value};
 
-use crate::output_file::{ensure_not_an_input, write_atomically};
 use crate::{Error, Result};
-use document::{padded_len, Document, Format};
 use edit::{array_mut, len_of, object_mut, push, root_mut, use_extension};
 
 pub use lights::EXTENSION;
+pub use restore::{restore_lights, RestoreSummary};
 
 /// One fitted light, in world space, as the fitter hands it over.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,6 +55,24 @@ pub struct LightToWrite {
     pub streak_id: Option<usize>,
 }
 
+/// Where a `.gltf` output finds the input's buffer and image files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InputFiles {
+    /// Copied beside the output under names made from its own: the output's folder holds
+    /// everything it needs.
+    #[default]
+    Copy,
+    /// Referred to where they are, by relative URIs (a warning says so): nothing is copied,
+    /// but the output breaks if they move, and a tool rewriting the output in place may write
+    /// into them. Only for a `.gltf` output.
+    Reference,
+}
+
+/// How far in front of its wall a light is written by default, in metres: a light exactly in
+/// its wall's plane is shadowed by the wall in renderers that trace shadow rays (Cycles let 7 %
+/// of such a light reach the water), and 1 mm is far below what a fit resolves.
+pub const DEFAULT_LIGHT_OFFSET: f64 = 0.001;
+
 /// How to write the lights.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WriteOptions {
@@ -73,6 +81,12 @@ pub struct WriteOptions {
     /// Intensity in the file = largest radiance component times this (683 turns W/(sr m^2)
     /// into nits). Must be finite and > 0.
     pub nits_scale: f64,
+    /// Each light's node is placed this far (metres, >= 0) in front of the fitted rectangle,
+    /// along the direction it emits: off its wall, so no renderer's shadow rays see the wall
+    /// first. [`DEFAULT_LIGHT_OFFSET`] by default.
+    pub light_offset: f64,
+    /// Where a `.gltf` output finds the input's files.
+    pub input_files: InputFiles,
 }
 
 impl Default for WriteOptions {
@@ -80,12 +94,14 @@ impl Default for WriteOptions {
         WriteOptions {
             fallback_quads: true,
             nits_scale: 1.0,
+            light_offset: DEFAULT_LIGHT_OFFSET,
+            input_files: InputFiles::Copy,
         }
     }
 }
 
 /// Which kind of object a rewritten URI belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ResourceKind {
     /// `buffers[index].uri`
     Buffer,
@@ -93,7 +109,8 @@ pub enum ResourceKind {
     Image,
 }
 
-/// A relative URI changed so it still reaches its file from the output's folder.
+/// A relative URI changed so it still reaches its file from the output's folder
+/// ([`InputFiles::Reference`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct UriRewrite {
     /// Buffer or image.
@@ -106,22 +123,30 @@ pub struct UriRewrite {
     pub to: String,
 }
 
-/// How a buffer that this writer created is stored.
+/// An input file copied beside a `.gltf` output ([`InputFiles::Copy`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum BufferStorage {
-    /// The BIN chunk of the output `.glb`.
-    GlbBinChunk,
-    /// An external file written next to the output.
-    ExternalFile(PathBuf),
+pub struct CopiedFile {
+    /// Buffer or image (the first one that uses the file).
+    pub kind: ResourceKind,
+    /// Its index in `buffers` or `images`.
+    pub index: usize,
+    /// The input's file.
+    pub from: PathBuf,
+    /// The copy.
+    pub to: PathBuf,
+    /// The URI the output uses for it.
+    pub uri: String,
 }
 
 /// Where the new binary data (the fallback quads) went.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum NewData {
     /// There was none (no lights, or fallback quads off).
+    #[default]
     Nothing,
-    /// Appended to the end of buffer 0 (the input GLB's BIN-chunk buffer, or a `data:` buffer 0
-    /// moved into the output GLB's BIN chunk), whose earlier bytes are unchanged.
+    /// Appended to the end of buffer 0 (a `.glb` output's BIN chunk, or a `.glb` input's BIN
+    /// chunk that a `.gltf` output stores as `<out>.streaklight.bin`), whose earlier bytes are
+    /// unchanged.
     AppendedToBuffer {
         /// The buffer's index.
         buffer: usize,
@@ -132,27 +157,32 @@ pub enum NewData {
     NewBuffer {
         /// The new buffer's index (the last one).
         buffer: usize,
-        /// How it is stored.
-        storage: BufferStorage,
+        /// Its file (`<out>.streaklight.bin`), or `None` for a `.glb`'s BIN chunk.
+        file: Option<PathBuf>,
     },
 }
 
 /// What was done about the document's binary data and the files it refers to.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct ResourceHandling {
-    /// Relative buffer/image URIs rewritten because the output is in another folder than the
-    /// input (empty when it is in the same folder). Files are never copied.
+    /// `.glb` output: the buffers and images whose bytes came from a URI (a file or `data:`)
+    /// into the BIN chunk.
+    pub embedded: Vec<(ResourceKind, usize)>,
+    /// `.gltf` output: the input's files copied beside it.
+    pub copied: Vec<CopiedFile>,
+    /// `.gltf` output with [`InputFiles::Reference`]: URIs rewritten to reach the input's
+    /// files from the output's folder (empty when it is the same folder).
     pub rewritten_uris: Vec<UriRewrite>,
     /// Where the new binary data went.
     pub new_data: NewData,
     /// For a `.glb` input written as `.gltf`: the file that now holds its BIN chunk (buffer 0).
     pub bin_chunk_moved_to: Option<PathBuf>,
-    /// For a `.glb` output whose input's buffer 0 was a `data:` URI: its bytes (unchanged)
-    /// now are the BIN chunk, and its `uri` was removed.
-    pub data_uri_buffer0_moved_to_bin_chunk: bool,
     /// GLB chunks of unknown type dropped because a `.gltf` output cannot hold them (readers
     /// ignore such chunks), plus a BIN chunk no buffer referred to.
     pub dropped_glb_chunks: usize,
+    /// Things the user should know (files referred to where they are, images at web
+    /// addresses that stay there).
+    pub warnings: Vec<String>,
     /// Every file written, the output scene last.
     pub files_written: Vec<PathBuf>,
 }
@@ -164,6 +194,9 @@ pub struct WriteSummary {
     pub light_indices: Vec<usize>,
     /// Index of each light's node in `nodes`.
     pub node_indices: Vec<usize>,
+    /// Each light node's translation: the light's centre moved [`WriteOptions::light_offset`]
+    /// along its normal.
+    pub node_translations: Vec<[f64; 3]>,
     /// Index of each light's fallback quad node (empty when fallback quads are off).
     pub fallback_node_indices: Vec<usize>,
     /// The scene the light nodes were added to.
@@ -182,309 +215,45 @@ pub fn write_lit_scene(
     lights: &[LightToWrite],
     options: &WriteOptions,
 ) -> Result<WriteSummary> {
-    let out_format = Format::from_output_path(output)?;
+    document::Format::from_output_path(output)?;
     if !(options.nits_scale.is_finite() && options.nits_scale > 0.0) {
         return Err(Error::Usage(format!(
             "the nits scale must be a positive number, not {}",
             options.nits_scale
         )));
     }
+    if !(options.light_offset.is_finite() && options.light_offset >= 0.0) {
+        return Err(Error::Usage(format!(
+            "the light offset must be a number of metres >= 0, not {}",
+            options.light_offset
+        )));
+    }
     let prepared = lights
         .iter()
         .enumerate()
-        .map(|(i, l)| lights::prepare(l, i, options.nits_scale))
+        .map(|(i, l)| lights::prepare(l, i, options.nits_scale, options.light_offset))
         .collect::<Result<Vec<_>>>()?;
-    let doc = document::read(input)?;
-    let input_dir = folder_of(input)
-        .canonicalize()
-        .map_err(|e| Error::io(input, e))?;
-    let output_dir = folder_of(output).canonicalize().map_err(|_| {
-        Error::output(
-            output,
-            format!("the folder {} does not exist", folder_of(output).display()),
-        )
-    })?;
-    let bin_path = output.with_extension("streaklight.bin");
-    let bin_name = bin_path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .map(resources::encode_path)
-        .ok_or_else(|| Error::output(output, "the output file name is not valid UTF-8"))?;
-
-    let mut json = doc.json.clone();
-    let bin_buffer0 = bin_chunk_buffer(&doc, input)?;
-    let unused_bin_chunk = doc.bin_chunk.is_some() && bin_buffer0.is_none();
-    let mut data_uri_moved = false;
-    let buffer0 = match bin_buffer0 {
-        None if out_format == Format::Glb => {
-            let moved = take_data_uri_buffer0(&mut json, input)?;
-            data_uri_moved = moved.is_some();
-            moved
-        }
-        other => other,
-    };
-    let local = resources::local_resources(&json, &input_dir);
-    let rewritten_uris = if input_dir == output_dir {
-        Vec::new()
-    } else {
-        resources::rewrite_uris(&mut json, &local, &output_dir, output)?
-    };
-
-    let root = root_mut(&mut json, input)?;
-    let quad_bytes = if options.fallback_quads && !prepared.is_empty() {
-        fallback_quad::bytes(&prepared)
-    } else {
-        Vec::new()
-    };
-    let placed = place_new_data(
-        root, buffer0, quad_bytes, out_format, &bin_name, &bin_path, input,
-    )?;
-
-    // Check every output against every input before writing anything.
-    let mut inputs: Vec<&Path> = vec![input];
-    inputs.extend(local.iter().map(|r| r.path.as_path()));
-    if placed.external.is_some() {
-        ensure_not_an_input(&bin_path, &inputs)?;
-    }
-    ensure_not_an_input(output, &inputs)?;
-
+    let mut staged = staged::stage(input, output, options.input_files)?;
     let mut summary = WriteSummary {
         light_indices: Vec::new(),
         node_indices: Vec::new(),
+        node_translations: prepared.iter().map(|p| p.translation).collect(),
         fallback_node_indices: Vec::new(),
         scene_index: 0,
-        resources: ResourceHandling {
-            rewritten_uris,
-            new_data: placed.new_data.clone(),
-            bin_chunk_moved_to: placed.bin_chunk_moved_to.clone(),
-            data_uri_buffer0_moved_to_bin_chunk: data_uri_moved,
-            dropped_glb_chunks: usize::from(unused_bin_chunk),
-            files_written: Vec::new(),
-        },
+        resources: ResourceHandling::default(),
     };
     if !prepared.is_empty() {
-        if let Some((buffer, offset)) = placed.quads_at {
+        if options.fallback_quads {
+            let at = staged.append_data(&fallback_quad::bytes(&prepared), input)?;
+            let root = root_mut(&mut staged.json, input)?;
             summary.fallback_node_indices =
-                fallback_quad::append(root, &prepared, buffer, offset, input)?;
+                fallback_quad::append(root, &prepared, at.0, at.1, input)?;
         }
+        let root = root_mut(&mut staged.json, input)?;
         append_lights(root, &prepared, &mut summary, input)?;
     }
-
-    let mut other_chunks = doc.other_chunks.clone();
-    let out_bytes = match out_format {
-        Format::Glb => document::glb_bytes(&json, placed.glb_bin.as_deref(), &other_chunks)?,
-        Format::Gltf => {
-            summary.resources.dropped_glb_chunks += other_chunks.len();
-            other_chunks.clear();
-            document::gltf_bytes(&json)?
-        }
-    };
-    summary.resources.files_written = write_files(output, &out_bytes, &bin_path, placed.external)?;
+    summary.resources = staged.write(output)?;
     Ok(summary)
-}
-
-/// The folder a path is in ("." for a bare file name).
-fn folder_of(path: &Path) -> &Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    }
-}
-
-/// The bytes of buffer 0 when it is stored in the input GLB's BIN chunk (its `byteLength`
-/// first bytes; the rest of the chunk is padding). Checks the buffers' storage while at it.
-fn bin_chunk_buffer(doc: &Document, input: &Path) -> Result<Option<Vec<u8>>> {
-    let buffers = doc.json.get("buffers").and_then(Value::as_array);
-    let Some(first) = buffers.and_then(|b| b.first()) else {
-        return Ok(None);
-    };
-    if doc.format == Format::Gltf {
-        if let Some(i) = buffers
-            .into_iter()
-            .flatten()
-            .position(|b| b.get("uri").is_none())
-        {
-            return Err(Error::scene(
-                input,
-                format!("buffer {i} has no \"uri\"; in a .gltf file every buffer needs one"),
-            ));
-        }
-        return Ok(None);
-    }
-    if first.get("uri").is_some() {
-        return Ok(None);
-    }
-    let chunk = doc.bin_chunk.as_deref().ok_or_else(|| {
-        Error::scene(
-            input,
-            "corrupt GLB file: buffer 0 has no \"uri\" but the file has no BIN chunk",
-        )
-    })?;
-    let len = first
-        .get("byteLength")
-        .and_then(Value::as_u64)
-        .and_then(|l| usize::try_from(l).ok())
-        .ok_or_else(|| Error::scene(input, "buffer 0 has no valid \"byteLength\""))?;
-    let bytes = chunk.get(..len).ok_or_else(|| {
-        Error::scene(
-            input,
-            format!(
-                "corrupt GLB file: buffer 0 is {len} bytes but the BIN chunk holds {}",
-                chunk.len()
-            ),
-        )
-    })?;
-    Ok(Some(bytes.to_vec()))
-}
-
-/// For a `.glb` output: when buffer 0 is a base64 `data:` URI, removes the URI and returns
-/// the buffer's bytes, which become the BIN chunk. Same index, same bytes, and no
-/// `DATA_URI_GLB` warning for it.
-fn take_data_uri_buffer0(json: &mut Value, input: &Path) -> Result<Option<Vec<u8>>> {
-    let Some(buffer) = json
-        .pointer_mut("/buffers/0")
-        .and_then(Value::as_object_mut)
-    else {
-        return Ok(None);
-    };
-    let Some(uri) = buffer.get("uri").and_then(Value::as_str) else {
-        return Ok(None);
-    };
-    let Some(payload) = uri
-        .strip_prefix("data:")
-        .and_then(|rest| rest.split_once(','))
-        .filter(|(header, _)| header.ends_with(";base64"))
-        .map(|(_, data)| data)
-    else {
-        return Ok(None);
-    };
-    let bytes = base64::engine::general_purpose::STANDARD
-        .decode(payload)
-        .map_err(|e| {
-            Error::scene(
-                input,
-                format!("buffer 0's data: URI is not valid base64: {e}"),
-            )
-        })?;
-    let len = buffer
-        .get("byteLength")
-        .and_then(Value::as_u64)
-        .and_then(|l| usize::try_from(l).ok())
-        .filter(|&l| l <= bytes.len())
-        .ok_or_else(|| {
-            Error::scene(
-                input,
-                format!(
-                    "buffer 0's \"byteLength\" is missing or over its {} bytes of data",
-                    bytes.len()
-                ),
-            )
-        })?;
-    // shift_remove keeps the order of the other keys (remove would swap the last one in).
-    buffer.shift_remove("uri");
-    Ok(Some(bytes[..len].to_vec()))
-}
-
-/// The outcome of [`place_new_data`].
-struct Placement {
-    /// Buffer index and byte offset of the quad data, if there is any.
-    quads_at: Option<(usize, usize)>,
-    new_data: NewData,
-    /// The BIN chunk of a `.glb` output.
-    glb_bin: Option<Vec<u8>>,
-    /// The bytes of `<out>.streaklight.bin`, for a `.gltf` output that needs it.
-    external: Option<Vec<u8>>,
-    bin_chunk_moved_to: Option<PathBuf>,
-}
-
-/// Decides where the new binary data goes (see the table in the module docs) and edits the
-/// `buffers` array accordingly. Existing buffers keep their index and their bytes.
-fn place_new_data(
-    root: &mut serde_json::Map<String, Value>,
-    buffer0: Option<Vec<u8>>,
-    new: Vec<u8>,
-    format: Format,
-    bin_name: &str,
-    bin_path: &Path,
-    input: &Path,
-) -> Result<Placement> {
-    if let Some(mut bytes) = buffer0 {
-        let mut quads_at = None;
-        let mut new_data = NewData::Nothing;
-        if !new.is_empty() {
-            // Our accessors need 4-byte alignment; the padding is new bytes, after the old.
-            let offset = padded_len(bytes.len());
-            bytes.resize(offset, 0);
-            bytes.extend_from_slice(&new);
-            quads_at = Some((0, offset));
-            new_data = NewData::AppendedToBuffer {
-                buffer: 0,
-                byte_offset: offset,
-            };
-        }
-        let grown = quads_at.is_some();
-        let buffers = array_mut(root, "buffers", input)?;
-        if let Some(b) = buffers.first_mut().and_then(Value::as_object_mut) {
-            // Untouched unless it grew: the input may spell the same number differently.
-            if grown {
-                b.insert("byteLength".into(), Value::from(bytes.len()));
-            }
-            if format == Format::Gltf {
-                b.insert("uri".into(), Value::from(bin_name));
-            }
-        }
-        return Ok(match format {
-            Format::Glb => Placement {
-                quads_at,
-                new_data,
-                glb_bin: Some(bytes),
-                external: None,
-                bin_chunk_moved_to: None,
-            },
-            Format::Gltf => Placement {
-                quads_at,
-                new_data,
-                glb_bin: None,
-                external: Some(bytes),
-                bin_chunk_moved_to: Some(bin_path.to_path_buf()),
-            },
-        });
-    }
-    let mut placement = Placement {
-        quads_at: None,
-        new_data: NewData::Nothing,
-        glb_bin: None,
-        external: None,
-        bin_chunk_moved_to: None,
-    };
-    if new.is_empty() {
-        return Ok(placement);
-    }
-    let index = len_of(root, "buffers");
-    let (buffer, storage) = match format {
-        // A buffer without a URI must be buffers[0] (GLB spec), so only an empty list may
-        // get a BIN chunk; otherwise indices would have to move. An external buffer 0 stays
-        // external, and so does our data.
-        Format::Glb if index == 0 => (
-            json!({ "byteLength": new.len(), "name": "streaklight" }),
-            BufferStorage::GlbBinChunk,
-        ),
-        Format::Glb | Format::Gltf => (
-            json!({ "byteLength": new.len(), "uri": bin_name, "name": "streaklight" }),
-            BufferStorage::ExternalFile(bin_path.to_path_buf()),
-        ),
-    };
-    push(root, "buffers", buffer, input)?;
-    placement.quads_at = Some((index, 0));
-    match storage {
-        BufferStorage::GlbBinChunk => placement.glb_bin = Some(new),
-        BufferStorage::ExternalFile(_) => placement.external = Some(new),
-    }
-    placement.new_data = NewData::NewBuffer {
-        buffer: index,
-        storage,
-    };
-    Ok(placement)
 }
 
 /// Appends the light objects, their nodes, and the nodes to the scene; lists the extension.
@@ -517,7 +286,10 @@ fn append_lights(
 }
 
 /// The default scene, else scene 0, else a new scene made the default.
-fn target_scene(root: &mut serde_json::Map<String, Value>, input: &Path) -> Result<usize> {
+pub(crate) fn target_scene(
+    root: &mut serde_json::Map<String, Value>,
+    input: &Path,
+) -> Result<usize> {
     let count = len_of(root, "scenes");
     if let Some(scene) = root.get("scene") {
         return scene
@@ -534,28 +306,4 @@ fn target_scene(root: &mut serde_json::Map<String, Value>, input: &Path) -> Resu
     let index = push(root, "scenes", json!({ "nodes": [] }), input)?;
     root.insert("scene".into(), Value::from(index));
     Ok(index)
-}
-
-/// Writes the external `.bin` (if any), then the scene. If the scene cannot be written, the
-/// `.bin` is removed again (or its previous content put back), so no stray file is left.
-fn write_files(
-    output: &Path,
-    out_bytes: &[u8],
-    bin_path: &Path,
-    external: Option<Vec<u8>>,
-) -> Result<Vec<PathBuf>> {
-    let Some(bin) = external else {
-        write_atomically(output, out_bytes)?;
-        return Ok(vec![output.to_path_buf()]);
-    };
-    let previous = std::fs::read(bin_path).ok();
-    write_atomically(bin_path, &bin)?;
-    if let Err(e) = write_atomically(output, out_bytes) {
-        let _ = match previous {
-            Some(old) => write_atomically(bin_path, &old),
-            None => std::fs::remove_file(bin_path).map_err(|e| Error::io(bin_path, e)),
-        };
-        return Err(e);
-    }
-    Ok(vec![bin_path.to_path_buf(), output.to_path_buf()])
 }

@@ -1,10 +1,10 @@
-//! The files a glTF document refers to (buffer and image URIs), and rewriting their relative
-//! URIs when the output is written to another folder than the input.
+//! The files a glTF document refers to (buffer and image URIs), and, for
+//! [`InputFiles::Reference`](super::InputFiles::Reference), rewriting their relative URIs when
+//! the output is written to another folder than the input.
 //!
-//! Choice: we rewrite, we do not copy. A rewritten URI is the relative path from the output's
-//! folder to the original file, so nothing is duplicated and no file beside the output can be
-//! overwritten by a copy. `data:` URIs and URIs with a scheme or an absolute path are left
-//! as they are. Only the core `buffers[].uri` and `images[].uri` are URIs of files in glTF 2.0.
+//! A rewritten URI is the relative path from the output's folder to the original file.
+//! `data:` URIs and URIs with a scheme or an absolute path are left as they are. Only the core
+//! `buffers[].uri` and `images[].uri` are URIs of files in glTF 2.0.
 
 use std::path::{Component, Path, PathBuf};
 

@@ -35,6 +35,12 @@ pub mod fit_helpers;
 /// Lossless checks on glTF outputs.
 pub mod gltf_check;
 
+/// The glTF writer's test inputs (lights, generated scenes, published samples).
+pub mod scene_out_case;
+
+/// What every output of the glTF writer must satisfy.
+pub mod scene_out_checks;
+
 /// Appends a fit setup (camera, water, wall, optional light) to glTF files we did not write.
 pub mod augment;
 

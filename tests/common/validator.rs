@@ -9,6 +9,16 @@ use serde_json::Value;
 
 /// The errors and warnings (code, JSON pointer) -> count the Khronos glTF-Validator reports.
 pub fn validator_problems(file: &Path) -> BTreeMap<(String, String), usize> {
+    validator_messages(file, 1)
+}
+
+/// The errors alone, as [`validator_problems`].
+pub fn validator_errors(file: &Path) -> BTreeMap<(String, String), usize> {
+    validator_messages(file, 0)
+}
+
+/// The messages of severity `max_severity` or more severe (0 error, 1 warning, 2 information).
+fn validator_messages(file: &Path, max_severity: u64) -> BTreeMap<(String, String), usize> {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/validator/validate.mjs");
     let out = Command::new("node").arg(script).arg(file).output().unwrap_or_else(|e| {
         panic!("cannot run `node` ({e}): run `scripts/test`, which installs Node.js and runs `npm ci --prefix tests/validator`")
@@ -23,7 +33,7 @@ pub fn validator_problems(file: &Path) -> BTreeMap<(String, String), usize> {
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     let mut problems = BTreeMap::new();
     for m in report["issues"]["messages"].as_array().unwrap() {
-        if m["severity"].as_u64().unwrap() <= 1 {
+        if m["severity"].as_u64().unwrap() <= max_severity {
             let key = (
                 m["code"].as_str().unwrap().to_string(),
                 m["pointer"].as_str().unwrap_or("").to_string(),

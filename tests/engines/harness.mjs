@@ -176,6 +176,9 @@ export async function openPage(browser, url) {
  * The lights a report promises, in the glTF's (right-handed, metres) world frame:
  * { name, nodeIndex, lightIndex, center, u, v, width, height, normal, radiance, nitsScale }.
  * `normal` is the direction of emission (towards the water): the report's plane normal.
+ * `center` is where an engine puts the light: its node's translation, which the report gives
+ * as `node_translation` (the fitted rectangle's `center` moved `settings.light_offset` along
+ * `normal`, off its wall); checked here to be exactly that.
  */
 export function expectedLights(reportPath) {
   let report;
@@ -185,24 +188,33 @@ export function expectedLights(reportPath) {
     fail(`cannot read the report ${reportPath}: ${e.message}`, 2);
   }
   const nitsScale = report.settings?.nits_scale ?? 1;
+  const offset = report.settings?.light_offset ?? 0;
   if (!Array.isArray(report.lights)) fail(`${reportPath} has no "lights" array`, 2);
   return {
     report,
     lights: report.lights
       .filter((l) => l.node_index !== null && l.node_index !== undefined)
-      .map((l) => ({
-        name: l.name,
-        nodeIndex: l.node_index,
-        lightIndex: l.light_index,
-        center: l.center,
-        u: l.u_axis,
-        v: l.v_axis,
-        width: l.width,
-        height: l.height,
-        normal: l.plane?.normal ?? cross(l.v_axis, l.u_axis),
-        radiance: l.radiance,
-        nitsScale,
-      })),
+      .map((l) => {
+        const normal = l.plane?.normal ?? cross(l.v_axis, l.u_axis);
+        const node = l.node_translation ?? l.center;
+        const moved = sub(node, l.center);
+        if (norm(sub(moved, scale(normal, offset))) > 1e-9 * Math.max(1, norm(l.center))) {
+          fail(`${reportPath}: light ${l.name}'s node_translation ${fmt(node)} is not its centre moved ${offset} m along its normal`, 2);
+        }
+        return {
+          name: l.name,
+          nodeIndex: l.node_index,
+          lightIndex: l.light_index,
+          center: node,
+          u: l.u_axis,
+          v: l.v_axis,
+          width: l.width,
+          height: l.height,
+          normal,
+          radiance: l.radiance,
+          nitsScale,
+        };
+      }),
   };
 }
 
