@@ -60,6 +60,22 @@ impl Photo {
         self.radiance.is_empty()
     }
 
+    /// Which channels of pixel `i` are clipped: those at the encoding's maximum when the
+    /// pixel is clipped (every channel of a pixel marked clipped by other means). The other
+    /// channels of a clipped pixel hold their true values: a light of one strong colour
+    /// clips its own channel only.
+    pub fn clipped_channels(&self, i: usize) -> [bool; 3] {
+        if !self.clipped[i] {
+            return [false; 3];
+        }
+        let at_max = self.display[i].map(|c| c >= 1.0);
+        if at_max.iter().any(|&c| c) {
+            at_max
+        } else {
+            [true; 3]
+        }
+    }
+
     /// Index of pixel (column `x`, row `y`).
     pub fn index(&self, x: u32, y: u32) -> usize {
         y as usize * self.width as usize + x as usize

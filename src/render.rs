@@ -19,6 +19,7 @@ use crate::progress::Reporter;
 use crate::random::Rng;
 use crate::scene_in::{AreaLight, Scene};
 use crate::settings::Setting;
+use crate::water_model::WaterModel;
 use crate::{Error, Result};
 
 /// How to render.
@@ -39,6 +40,10 @@ pub struct RenderOptions<'a> {
     pub shadowing: Shadowing,
     /// Told the rows done as they finish (silent by default).
     pub progress: Reporter<'a>,
+    /// How the water reflects: `None` for the scene's own water mesh (the photo's waves);
+    /// a statistical model renders its expected image instead (the mean over the waves it
+    /// describes), as the fit under that model sees the photo.
+    pub water: Option<&'a dyn WaterModel>,
 }
 
 impl Default for RenderOptions<'_> {
@@ -51,6 +56,7 @@ impl Default for RenderOptions<'_> {
             seed: 1,
             shadowing: Shadowing::None,
             progress: Reporter::default(),
+            water: None,
         }
     }
 }
@@ -145,9 +151,25 @@ pub struct WaterPoint {
     pub normal: Vec3,
     /// Geometric normal, turned to the camera's side.
     pub face: Vec3,
+    /// Height above `start`, along `face`, below which a reflected ray ignores what it hits
+    /// (0 for the exact model): a statistical model's rays leave its mean plane, under the
+    /// crests of the scene's own waves, which must not shadow them a second time.
+    pub clear: f32,
 }
 
 impl WaterPoint {
+    /// The distance along a reflected ray in direction `wi` before which it ignores what it
+    /// hits ([`clear`](Self::clear)): the ray is the one from `start`, only its occlusion
+    /// starts above the crests.
+    #[inline]
+    pub fn tmin(&self, wi: Vec3) -> f32 {
+        if self.clear > 0.0 {
+            self.clear / wi.dot(self.face).max(1e-3)
+        } else {
+            0.0
+        }
+    }
+
     /// One reflected lobe sample for the uniform pair `u`; `None` when the model rejects it
     /// or the ray would enter the water geometrically (it then sees nothing, but still
     /// counts in the pixel's mean).
@@ -205,6 +227,7 @@ pub fn camera_hit(
         wo,
         normal: scene.shading_normal(hit.triangle, hit.barycentric),
         face,
+        clear: 0.0,
     })
 }
 
@@ -261,6 +284,7 @@ pub fn render_with_lights(
                         scene,
                         lights,
                         &model,
+                        options.water,
                         PixelSample {
                             x: x as u32,
                             y: y as u32,
@@ -325,10 +349,12 @@ struct PixelSample {
 
 /// One camera ray of a pixel: the mean radiance its lobe samples carry, and how many
 /// reflected rays were traced.
+#[allow(clippy::too_many_arguments)]
 fn pixel_sample(
     scene: &Scene,
     lights: &[AreaLight],
     model: &ReflectionModel,
+    water_model: Option<&dyn WaterModel>,
     s: PixelSample,
     w: u32,
     h: u32,
@@ -340,20 +366,35 @@ fn pixel_sample(
         fx = ((s.stratum % s.strata) as f32 + fx) / n;
         fy = ((s.stratum / s.strata) as f32 + fy) / n;
     }
-    let water = match camera_hit(scene, lights, s.x as f32 + fx, s.y as f32 + fy, w, h) {
+    let (x, y) = (s.x as f32 + fx, s.y as f32 + fy);
+    let water = match camera_hit(scene, lights, x, y, w, h) {
         CameraHit::Light(i) => return (lights[i].radiance, 0),
         CameraHit::Other => return ([0.0; 3], 0),
         CameraHit::Water(water) => water,
+    };
+    // Under another water model the camera ray meets that model's surface (a statistical
+    // model's mean plane) where the scene's mesh says it sees water.
+    let water = match water_model {
+        None => water,
+        Some(m) => match m.water_point(scene, x, y, w, h) {
+            Some(p) => p,
+            None => return ([0.0; 3], 0),
+        },
     };
     let mut sum = [0f32; 3];
     let mut traced = 0;
     for _ in 0..s.lobe_samples {
         let u = Vec2::new(rng.next_f32(), rng.next_f32());
-        let Some(sample) = water.reflect(model, u) else {
+        let sample = match water_model {
+            None => water.reflect(model, u),
+            Some(m) => m.reflect(&water, model, u),
+        };
+        let Some(sample) = sample else {
             continue;
         };
         traced += 1;
-        if let Some(i) = visible_light(scene, lights, water.start, sample.wi, 0.0) {
+        if let Some(i) = visible_light(scene, lights, water.start, sample.wi, water.tmin(sample.wi))
+        {
             let l = lights[i].radiance;
             for c in 0..3 {
                 sum[c] += l[c] * sample.weight;

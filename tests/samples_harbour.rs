@@ -218,3 +218,38 @@ fn committed_photos_are_what_the_truth_scenes_render() {
         assert!(difference > 2.0 * bound, "{difference}");
     }
 }
+
+/// The mean surface the statistical water model takes from a wave mesh is the waves' rest
+/// level (y = 0 in the world, where the samples put it) whatever the realisation: its normal
+/// within 1e-3 rad of up and its height within 5 mm (the waves' heights have an rms of 2 cm).
+/// The plane of the camera's hits would lean towards this grazing camera (2 m above the
+/// water) by 0.5-0.8 degrees, since it sees the wave faces turned towards it, and turn every
+/// reflection by twice that.
+#[test]
+fn the_mean_surface_of_a_wave_mesh_is_its_rest_level() {
+    for file in [
+        "harbour-other-waves.gltf",
+        "harbour-above.gltf",
+        "scene-other-waves.gltf",
+    ] {
+        let scene = load(file);
+        let stats = streaklight::water_model::water_statistics(&scene, 600, 600).unwrap();
+        let n = stats.surface.normal;
+        let tilt = n.cross(Vec3::Y).length();
+        assert!(
+            tilt < 1e-3,
+            "{file}: the mean plane leans by {tilt} rad ({n:?})"
+        );
+        let rest = (-scene.origin.y) as f32; // world y = 0 in the camera-centred frame
+        let height = stats.surface.point.y - rest;
+        assert!(
+            height.abs() < 5e-3,
+            "{file}: the mean plane is {height} m off the rest level"
+        );
+        assert!(
+            stats.surface.crest > 0.0 && stats.surface.crest < 0.2,
+            "{file}: crest {}",
+            stats.surface.crest
+        );
+    }
+}

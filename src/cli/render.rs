@@ -71,6 +71,7 @@ pub fn run(args: Args, out: &Output) -> streaklight::Result<()> {
         seed: args.seed,
         shadowing: args.scene_options.shadowing(),
         progress: out.progress(),
+        water: None,
     };
     let image = render(&scene, &options)?;
     photo_out::write(&args.output, image.width, image.height, &image.pixels)?;

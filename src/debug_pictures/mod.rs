@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use image::{Rgb, RgbImage};
 
 use crate::convert::{area_light, ConvertOptions};
+use crate::optics::GaussianSlopes;
 use crate::output_file::write_atomically;
 use crate::photo_in::{linear_to_srgb, Photo};
 use crate::pipeline::{light_name, Lit};
@@ -27,6 +28,7 @@ use crate::render::{self, RenderOptions};
 use crate::report::Report;
 use crate::scene_in::{AreaLight, Scene};
 use crate::streaks::pictures::write_png;
+use crate::water_model::{water_statistics, StatisticalSurface, WaterModel};
 use crate::{streaks, Error, Result};
 use canvas::{label, outline, side_by_side, with_header, Key};
 use html::Figure;
@@ -118,6 +120,7 @@ fn render_lights(
     photo: &Photo,
     spp: u32,
     options: &ConvertOptions,
+    water: Option<&dyn WaterModel>,
 ) -> Result<Vec<[f32; 3]>> {
     let image = render::render_with_lights(
         scene,
@@ -130,6 +133,7 @@ fn render_lights(
             seed: options.fit.seed,
             shadowing: options.fit.shadowing,
             progress: options.progress,
+            water,
         },
     )?;
     Ok(image.pixels)
@@ -187,6 +191,24 @@ fn reflection_mask(pixels: &[[f32; 3]], water: &[bool], width: u32) -> Vec<bool>
         .collect()
 }
 
+/// The slope variance of the scene water's own microfacets (its gloss), per axis.
+fn micro_variance(scene: &Scene) -> f32 {
+    GaussianSlopes::from_gloss(scene.water.gloss).variance[0]
+}
+
+/// The statistical water the fit used, as the renderer takes it (its microfacets are the
+/// scene's gloss, the waves carry the rest of the fitted slope variances); `None` when the
+/// fit used the exact water.
+fn statistical_water(scene: &Scene, photo: &Photo, lit: &Lit) -> Option<StatisticalSurface> {
+    let slopes = lit.water_model.slopes.as_ref()?;
+    let surface = water_statistics(scene, photo.width, photo.height)?.surface;
+    let micro = micro_variance(scene);
+    Some(StatisticalSurface {
+        surface,
+        waves: slopes.variance.map(|v| (v - micro).max(0.0)),
+    })
+}
+
 /// The photo with the lights' reflections outlined, the model, and the signed residual, side
 /// by side, each titled.
 fn fit_picture(
@@ -207,7 +229,9 @@ fn fit_picture(
         "debug pictures: the water re-rendered with the {} fitted light(s)",
         area.len()
     ));
-    let model = render_lights(scene, &area, photo, MODEL_SPP, options)?;
+    let statistical = statistical_water(scene, photo, lit);
+    let water_model = statistical.as_ref().map(|w| w as &dyn WaterModel);
+    let model = render_lights(scene, &area, photo, MODEL_SPP, options, water_model)?;
     let photo_linear: Vec<[f32; 3]> = photo
         .radiance
         .iter()
@@ -231,6 +255,7 @@ fn fit_picture(
             photo,
             OUTLINE_SPP,
             options,
+            water_model,
         )?;
         let mask = reflection_mask(&alone, water, width);
         let colour = light_colour(k);
@@ -250,13 +275,18 @@ fn fit_picture(
         ),
         &keys,
     );
-    let model_panel = with_header(
-        &srgb_image(width, height, &model),
-        &format!(
+    let model_title = match &statistical {
+        None => format!(
             "Model: the water re-rendered with the fitted lights ({MODEL_SPP} rays per pixel)"
         ),
-        &[],
-    );
+        Some(w) => format!(
+            "Model: the expected image of the fitted lights over waves of slope variance \
+             {:.2e} along, {:.2e} across (statistical water, {MODEL_SPP} rays per pixel)",
+            w.waves[0] + micro_variance(scene),
+            w.waves[1] + micro_variance(scene)
+        ),
+    };
+    let model_panel = with_header(&srgb_image(width, height, &model), &model_title, &[]);
     let residual: Vec<f32> = photo_linear
         .iter()
         .zip(&model)

@@ -190,7 +190,7 @@ pub fn footprint_with(
                 (y + k / side).saturating_sub(radius),
             )
         };
-        let Some((start, sample)) =
+        let Some((start, sample, tmin)) =
             reflected_sample(water_model, scene, model, bx, by, width, height, &mut rng)
         else {
             continue;
@@ -200,7 +200,7 @@ pub fn footprint_with(
         let Some(t_plane) = plane.distance(start, sample.wi) else {
             continue;
         };
-        if let Some(hit) = first_surface(scene, start, sample.wi, t_plane * 1.001 + 1e-3) {
+        if let Some(hit) = first_surface(scene, start, sample.wi, tmin, t_plane * 1.001 + 1e-3) {
             if plane.contains_triangle(scene, hit.triangle) {
                 fp.points.push(plane.coords(start + sample.wi * hit.t));
                 fp.weights.push(sample.weight);
@@ -214,6 +214,12 @@ pub fn footprint_with(
 /// the plane). Area lights already in the scene are not geometry and do not occlude: the fit
 /// asks what a light on the plane would show, and an existing light coplanar with its wall
 /// must not hide the wall (it would, by rounding, for about half the rays).
-fn first_surface(scene: &Scene, origin: glam::Vec3, dir: glam::Vec3, tmax: f32) -> Option<Hit> {
-    scene.tracer.closest_hit(origin, dir, 0.0, tmax)
+fn first_surface(
+    scene: &Scene,
+    origin: glam::Vec3,
+    dir: glam::Vec3,
+    tmin: f32,
+    tmax: f32,
+) -> Option<Hit> {
+    scene.tracer.closest_hit(origin, dir, tmin, tmax)
 }

@@ -15,9 +15,11 @@
 //! average over tilted facets down to 4 degrees above the water, where without it the
 //! facets turned towards the camera count 3 % too much (the tests below).
 //!
-//! The reflected rays leave from the mean plane lifted to the scene's highest crest
-//! ([`MeanSurface::crest`]): the scene's own waves must not shadow them a second time, and the
-//! lift (millimetres to centimetres) moves nothing a light's plane metres away can show.
+//! The reflected rays leave from the mean plane, and ignore whatever they meet below the
+//! scene's highest crest ([`MeanSurface::crest`], [`WaterPoint::clear`]): the scene's own
+//! waves must not shadow them a second time. Lifting their origin to the crest instead would
+//! move every reflection by the crest's height (8 cm over the harbour sample's waves: 4 % of
+//! a 2 m light, and 2 % more reflected energy in its expected image).
 //!
 //! Which pixels see water is still the scene's business: a camera ray counts when its first
 //! hit is a water triangle (so the quay, boats and the far shore hide the water as they do in
@@ -72,10 +74,11 @@ impl WaterModel for StatisticalSurface {
         let (p, _) = self.surface.hit(origin, dir)?;
         let n = self.surface.normal;
         Some(WaterPoint {
-            start: p + n * (self.surface.crest + surface_offset(p)),
+            start: p + n * surface_offset(p),
             wo: -dir,
             normal: n,
             face: n,
+            clear: self.surface.crest,
         })
     }
 

@@ -84,7 +84,7 @@ impl Problem {
                 (0..3)
                     .map(|c| {
                         let r = self.obs[i][c] as f64 - m[c];
-                        if self.clipped[i] && r < 0.0 {
+                        if self.clipped_channels[i][c] && r < 0.0 {
                             0.0
                         } else if remove_noise {
                             let d: f64 = st
@@ -130,16 +130,20 @@ impl Problem {
     }
 
     /// Re-solves every radiance given the rectangles: per channel, nonnegative least squares
-    /// over the pixels, a clipped pixel included only while the model stays below it.
+    /// over the pixels, a clipped channel included only while the model stays below it.
     pub(super) fn solve_radiance(&self, st: &mut State) {
         let k = st.rects.len();
-        let mut include: Vec<bool> = self.clipped.iter().map(|c| !c).collect();
+        let mut include: Vec<[bool; 3]> = self
+            .clipped_channels
+            .iter()
+            .map(|c| c.map(|c| !c))
+            .collect();
         for _round in 0..3 {
             for ch in 0..3 {
                 let mut ata = vec![0.0; k * k];
                 let mut atb = vec![0.0; k];
                 let mut raw_diag = vec![0.0; k];
-                for i in (0..self.n()).filter(|&i| include[i]) {
+                for i in (0..self.n()).filter(|&i| include[i][ch]) {
                     for a in 0..k {
                         let ca = st.coef[a][i] as f64;
                         if ca == 0.0 {
@@ -165,10 +169,12 @@ impl Problem {
             let mut changed = false;
             for i in (0..self.n()).filter(|&i| self.clipped[i]) {
                 let m = self.model(st, i);
-                let below = (0..3).any(|c| m[c] < self.obs[i][c] as f64);
-                if below != include[i] {
-                    include[i] = below;
-                    changed = true;
+                for c in 0..3 {
+                    let counts = !self.clipped_channels[i][c] || m[c] < self.obs[i][c] as f64;
+                    if counts != include[i][c] {
+                        include[i][c] = counts;
+                        changed = true;
+                    }
                 }
             }
             if !changed {

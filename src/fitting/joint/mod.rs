@@ -352,6 +352,10 @@ pub fn fit_joint_with(
             pixel_ids: pixels.clone(),
             obs: pixels.iter().map(|&p| photo.radiance[p as usize]).collect(),
             clipped: pixels.iter().map(|&p| photo.clipped[p as usize]).collect(),
+            clipped_channels: pixels
+                .iter()
+                .map(|&p| photo.clipped_channels(p as usize))
+                .collect(),
             planes: stored,
             set_origin: (0..planes.len()).collect(),
             inv_samples: 1.0 / per_pixel_samples as f32,

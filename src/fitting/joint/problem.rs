@@ -17,6 +17,9 @@ pub(super) struct Problem {
     pub(super) obs: Vec<[f32; 3]>,
     /// Per fitted pixel, whether the photo clipped it (its value is a lower bound).
     pub(super) clipped: Vec<bool>,
+    /// Per fitted pixel, which of its channels the photo clipped (a clipped pixel's other
+    /// channels are exact values).
+    pub(super) clipped_channels: Vec<[bool; 3]>,
     /// The sample sets: one per start light, then one per light a split added.
     pub(super) planes: Vec<PlaneSamples>,
     /// Per sample set, the start light whose plane it samples (a split light reads a set of

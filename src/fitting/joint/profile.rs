@@ -245,8 +245,11 @@ impl Problem {
                             .sum();
                         let r = self.obs[*i][ch] as f64 - rest - l[ch] * c;
                         let r0 = self.obs[*i][ch] as f64 - rest;
-                        let now = if r < 0.0 { 0.0 } else { r * r };
-                        let before = if r0 < 0.0 { 0.0 } else { r0 * r0 };
+                        // A clipped channel is a lower bound; the pixel's other channels
+                        // are values.
+                        let bound = self.clipped_channels[*i][ch];
+                        let now = if bound && r < 0.0 { 0.0 } else { r * r };
+                        let before = if bound && r0 < 0.0 { 0.0 } else { r0 * r0 };
                         cost += now - before;
                     }
                 }

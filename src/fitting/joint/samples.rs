@@ -254,7 +254,9 @@ pub(super) fn trace_samples(
                         continue;
                     };
                     let tmax = reach * 1.001 + 1e-3;
-                    let hit = scene.tracer.closest_hit(water.start, s.wi, 0.0, tmax);
+                    let hit = scene
+                        .tracer
+                        .closest_hit(water.start, s.wi, water.tmin(s.wi), tmax);
                     let mut lobe_cell = None;
                     for (k, plane) in planes.iter().enumerate() {
                         let g = &gauss[k];
