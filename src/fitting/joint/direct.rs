@@ -102,7 +102,7 @@ pub(super) fn direct_pixels(
 /// The box of pixels (inclusive) where the regions of interest project, grown by a pixel,
 /// clipped to the image; the whole image when a corner lies behind the camera (its
 /// projection is then no bound); `None` when it misses the image.
-fn image_box(
+pub(super) fn image_box(
     scene: &Scene,
     planes: &[&LightPlane],
     roi: &[Rect],

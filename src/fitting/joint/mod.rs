@@ -62,6 +62,7 @@
 //! | `mod.rs` | options, outcome, [`fit_joint`] |
 //! | `region` | the fitted pixels, each light's region of interest |
 //! | `direct` | the pixels that see a light's wall directly, their samples |
+//! | `direct_start` | starts far from a light's direct image moved onto it, fragments merged |
 //! | `samples` | tracing and storing the plane samples, a coefficient from them |
 //! | `kernel` | each sample's cell and kernel |
 //! | `control_variate` | the lobe Gaussian |
@@ -92,6 +93,7 @@ mod control_variate;
 mod cost;
 mod descent;
 mod direct;
+mod direct_start;
 #[cfg(test)]
 mod fixture;
 mod kernel;
@@ -278,6 +280,22 @@ pub fn fit_joint_with(
             modelled: Vec::new(),
         });
     }
+    // Starts far from the lights' direct images are moved onto them (`direct_start`).
+    let moved;
+    let start = if options.direct_view {
+        moved = direct_start::direct_starts(scene, photo, water, start);
+        if moved.len() < start.len() {
+            options.progress.stage(&format!(
+                "joint fit: {} of {} start light(s) merged into another whose lamp's direct \
+                 image they lay on",
+                start.len() - moved.len(),
+                start.len()
+            ));
+        }
+        &moved[..]
+    } else {
+        start
+    };
     let used: Vec<&StreakObservation> = streaks
         .iter()
         .filter(|s| start.iter().any(|l| l.streak_ids.contains(&s.id)))

@@ -1,0 +1,413 @@
+//! Where the direct view puts a light before the joint fit starts.
+//!
+//! The joint fit refines its start locally: each edge moves within windows around where it
+//! starts, and a light whose start is far from the truth stays far. The paper's per-streak
+//! estimate can start a light badly where the reflections alone cannot tell its shape (a
+//! streak over waves the scene does not hold gave one light 14 m x 1 cm for a 4 m x 2 m
+//! light), and a streak broken into fragments can give a second light for the same lamp.
+//! When the lamp itself is in the photo its direct image says where it is to a pixel, so:
+//!
+//! - a light whose start overlaps the direct image near it by less than
+//!   [`REPLACE_OVERLAP`] (intersection over union) starts at that image's rectangle instead;
+//! - a light so moved onto the direct image another light already starts on is merged into
+//!   that light (its streaks join the other's): one lamp, one light.
+//!
+//! A start that already overlaps its direct image well is left alone, so that two lights
+//! whose direct images touch (stacked lamps) keep the starts the reflections gave them.
+//!
+//! The direct image near a light: the pixels outside the water whose camera ray (through the
+//! pixel's centre) meets the light's plane first, within the start rectangle grown by its own
+//! larger side on every side, and that are bright (clipped in some channel, or at least half
+//! the brightest such pixel's largest channel); of their 8-connected groups in the image,
+//! the one whose centre on the plane is nearest the start's centre.
+
+use std::collections::VecDeque;
+
+use glam::Vec2;
+
+use super::direct::image_box;
+use crate::fitting::rect::Rect;
+use crate::fitting::FittedLight;
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+
+/// A start overlapping its direct image by less than this (intersection over union) is
+/// moved onto it. Two stacked lamps' starts overlap their joint image by about a half.
+pub const REPLACE_OVERLAP: f32 = 0.25;
+
+/// Fewest pixels a direct image must have to move a start.
+const MIN_PIXELS: usize = 4;
+
+/// A bright group of direct pixels on a light's plane.
+struct DirectImage {
+    /// Its pixels' smallest index: the group's identity.
+    first_pixel: usize,
+    /// Its bounding rectangle on the plane, grown by half a pixel's footprint.
+    rect: Rect,
+}
+
+/// The starts moved onto their direct images and merged where they meet (module doc).
+pub(super) fn direct_starts(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    start: &[FittedLight],
+) -> Vec<FittedLight> {
+    let mut out: Vec<FittedLight> = Vec::with_capacity(start.len());
+    // For each light of `out`, the direct image it starts on, if any.
+    let mut on_image: Vec<Option<usize>> = Vec::with_capacity(start.len());
+    for light in start {
+        let image = direct_image(scene, photo, water, light);
+        let moved = image
+            .as_ref()
+            .filter(|im| overlap(&light.rect(), &im.rect) < REPLACE_OVERLAP);
+        let Some(im) = moved else {
+            on_image.push(
+                image
+                    .filter(|im| overlap(&light.rect(), &im.rect) >= REPLACE_OVERLAP)
+                    .map(|im| im.first_pixel),
+            );
+            out.push(light.clone());
+            continue;
+        };
+        let same_image = on_image.iter().position(|&o| o == Some(im.first_pixel));
+        match same_image {
+            Some(k) if same_plane(&out[k], light) => {
+                out[k].streak_ids.extend(light.streak_ids.iter().copied());
+            }
+            _ => {
+                let mut moved = light.clone();
+                moved.u_min = im.rect.u_min;
+                moved.u_max = im.rect.u_max;
+                moved.v_min = im.rect.v_min;
+                moved.v_max = im.rect.v_max;
+                on_image.push(Some(im.first_pixel));
+                out.push(moved);
+            }
+        }
+    }
+    // A light that kept its start, found later to share its image with a moved one: the
+    // moved one was pushed as its own light above only when it came first. Merge those too.
+    let mut k = 0;
+    while k < out.len() {
+        let twin = (0..k).find(|&j| {
+            on_image[j].is_some() && on_image[j] == on_image[k] && same_plane(&out[j], &out[k])
+        });
+        if let Some(j) = twin {
+            let ids = out[k].streak_ids.clone();
+            out[j].streak_ids.extend(ids);
+            out.remove(k);
+            on_image.remove(k);
+        } else {
+            k += 1;
+        }
+    }
+    for light in &mut out {
+        light.streak_ids.sort_unstable();
+        light.streak_ids.dedup();
+    }
+    out
+}
+
+/// Whether two lights lie on one plane (their planes' normals and offsets agree).
+fn same_plane(a: &FittedLight, b: &FittedLight) -> bool {
+    let (pa, pb) = (&a.plane, &b.plane);
+    pa.normal.dot(pb.normal) > 0.999 && (pb.point - pa.point).dot(pa.normal).abs() < 1e-3
+}
+
+/// Intersection over union of two rectangles (0 when either is empty).
+fn overlap(a: &Rect, b: &Rect) -> f32 {
+    let w = (a.u_max.min(b.u_max) - a.u_min.max(b.u_min)).max(0.0);
+    let h = (a.v_max.min(b.v_max) - a.v_min.max(b.v_min)).max(0.0);
+    let inter = w * h;
+    let union = a.width() * a.height() + b.width() * b.height() - inter;
+    if union > 0.0 {
+        inter / union
+    } else {
+        0.0
+    }
+}
+
+/// The direct image near `light` (module doc), or `None` when the photo shows none.
+fn direct_image(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    light: &FittedLight,
+) -> Option<DirectImage> {
+    let start = light.rect();
+    let search = start.grow(start.width().max(start.height()));
+    let plane = &light.plane;
+    let (w, h) = (photo.width, photo.height);
+    let (x0, y0, x1, y1) = image_box(scene, &[plane], &[search], w, h)?;
+    // The pixels of the box that see the plane inside the search rectangle: index, plane
+    // coordinates, distance from the camera, brightness.
+    let mut seen: Vec<(usize, Vec2, f32, f32)> = Vec::new();
+    let origin = scene.camera.position;
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let i = photo.index(x, y);
+            if water[i] {
+                continue;
+            }
+            let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
+            let Some(hit) = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY) else {
+                continue;
+            };
+            if !plane.contains_triangle(scene, hit.triangle) {
+                continue;
+            }
+            let q = plane.coords(origin + dir * hit.t);
+            if !search.contains(q) {
+                continue;
+            }
+            let value = if photo.clipped[i] {
+                f32::INFINITY
+            } else {
+                photo.radiance[i].into_iter().fold(0.0f32, f32::max)
+            };
+            seen.push((i, q, hit.t, value));
+        }
+    }
+    let brightest = seen
+        .iter()
+        .map(|s| s.3)
+        .filter(|v| v.is_finite())
+        .fold(0.0f32, f32::max);
+    let any_clipped = seen.iter().any(|s| s.3.is_infinite());
+    if brightest <= 0.0 && !any_clipped {
+        return None;
+    }
+    let threshold = if any_clipped && brightest <= 0.0 {
+        f32::INFINITY
+    } else {
+        0.5 * brightest
+    };
+    let bright: Vec<&(usize, Vec2, f32, f32)> = seen.iter().filter(|s| s.3 >= threshold).collect();
+    let groups = groups_8(&bright.iter().map(|s| s.0).collect::<Vec<_>>(), w as usize);
+    // One pixel's footprint on the plane at distance t, across: t times the pixel's angle.
+    let pixel_angle = 2.0 * (scene.camera.yfov * 0.5).tan() / h as f32;
+    let centre = start.center();
+    groups
+        .into_iter()
+        .filter(|g| g.len() >= MIN_PIXELS)
+        .map(|g| {
+            let mut rect = Rect {
+                u_min: f32::INFINITY,
+                u_max: f32::NEG_INFINITY,
+                v_min: f32::INFINITY,
+                v_max: f32::NEG_INFINITY,
+            };
+            let mut t_sum = 0.0;
+            for &m in &g {
+                let (_, q, t, _) = bright[m];
+                rect.u_min = rect.u_min.min(q.x);
+                rect.u_max = rect.u_max.max(q.x);
+                rect.v_min = rect.v_min.min(q.y);
+                rect.v_max = rect.v_max.max(q.y);
+                t_sum += t;
+            }
+            let half_pixel = 0.5 * pixel_angle * t_sum / g.len() as f32;
+            DirectImage {
+                first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
+                rect: rect.grow(half_pixel),
+            }
+        })
+        .min_by(|a, b| {
+            let da = (a.rect.center() - centre).length();
+            let db = (b.rect.center() - centre).length();
+            da.total_cmp(&db)
+        })
+}
+
+/// The 8-connected groups of the image pixels `pixels` (indices into a row-major image of
+/// width `width`), each a list of positions in `pixels`.
+fn groups_8(pixels: &[usize], width: usize) -> Vec<Vec<usize>> {
+    let position: std::collections::HashMap<usize, usize> =
+        pixels.iter().enumerate().map(|(k, &p)| (p, k)).collect();
+    let mut group_of = vec![usize::MAX; pixels.len()];
+    let mut groups = Vec::new();
+    for k in 0..pixels.len() {
+        if group_of[k] != usize::MAX {
+            continue;
+        }
+        let id = groups.len();
+        let mut members = Vec::new();
+        let mut queue = VecDeque::from([k]);
+        group_of[k] = id;
+        while let Some(m) = queue.pop_front() {
+            members.push(m);
+            let (x, y) = ((pixels[m] % width) as i64, (pixels[m] / width) as i64);
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if (dx, dy) == (0, 0) || nx < 0 || ny < 0 || nx >= width as i64 {
+                        continue;
+                    }
+                    let p = ny as usize * width + nx as usize;
+                    if let Some(&n) = position.get(&p) {
+                        if group_of[n] == usize::MAX {
+                            group_of[n] = id;
+                            queue.push_back(n);
+                        }
+                    }
+                }
+            }
+        }
+        groups.push(members);
+    }
+    groups
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fitting::light_plane::LightPlane;
+    use crate::fitting::EdgeStatus;
+    use glam::Vec3;
+
+    /// Table 1's scene and photo (one 3 m x 3 m light on the wall, in frame), the wall as a
+    /// light plane, and the light's true rectangle on it (from the sample's definition).
+    fn table1() -> (Scene, Photo, Vec<bool>, LightPlane, Rect) {
+        let (scene, photo, water, _) = crate::samples::fixture("table1.png");
+        let origin = scene.camera.position;
+        let dir = scene
+            .camera
+            .direction(300.5, 100.5, photo.width, photo.height);
+        let hit = scene
+            .tracer
+            .closest_hit(origin, dir, 0.0, f32::INFINITY)
+            .expect("the wall");
+        let s = scene.sources[hit.triangle as usize];
+        let mut normal = scene.face_normal(hit.triangle);
+        if normal.dot(dir) > 0.0 {
+            normal = -normal;
+        }
+        let plane = LightPlane::with_frame(
+            (s.node as usize, s.mesh as usize, s.primitive as usize),
+            origin + dir * hit.t,
+            normal,
+            Vec3::X,
+            1.0,
+        )
+        .expect("a plane");
+        let truth = crate::samples::table1_light();
+        let at = |x: f64, y: f64| {
+            plane.coords((glam::DVec3::new(x, y, truth.corner.z) - scene.origin).as_vec3())
+        };
+        let (a, b) = (
+            at(truth.corner.x, truth.corner.y),
+            at(truth.corner.x + truth.width, truth.corner.y + truth.height),
+        );
+        let rect = Rect {
+            u_min: a.x.min(b.x),
+            u_max: a.x.max(b.x),
+            v_min: a.y.min(b.y),
+            v_max: a.y.max(b.y),
+        };
+        (scene, photo, water, plane, rect)
+    }
+
+    fn light(plane: &LightPlane, rect: Rect, streak: usize) -> FittedLight {
+        let free = || EdgeStatus::Constrained { pixels: 1 };
+        FittedLight {
+            streak_ids: vec![streak],
+            plane: plane.clone(),
+            u_min: rect.u_min,
+            u_max: rect.u_max,
+            v_min: rect.v_min,
+            v_max: rect.v_max,
+            radiance: [1.0; 3],
+            edges: [free(), free(), free(), free()],
+        }
+    }
+
+    /// A start 14 m wide and 1 cm tall across the light (as the reflections alone gave one)
+    /// moves onto the light's direct image: every edge within a pixel's footprint on the
+    /// wall (10 m away, 60 degrees over 600 pixels: 1.8 cm) of the truth. A second start
+    /// far off on the same image (a fragment of the streak) is merged into it, its streak
+    /// joining the first's; a start that already overlaps the image well stays as it was.
+    #[test]
+    fn far_starts_move_onto_the_direct_image_and_fragments_merge() {
+        let (scene, photo, water, plane, truth) = table1();
+        let c = truth.center();
+        let thin = Rect {
+            u_min: c.x - 7.0,
+            u_max: c.x + 7.0,
+            v_min: c.y - 0.4,
+            v_max: c.y - 0.39,
+        };
+        let fragment = Rect {
+            u_min: c.x + 0.5,
+            u_max: c.x + 3.5,
+            v_min: c.y + 1.0,
+            v_max: c.y + 6.0,
+        };
+        let out = direct_starts(
+            &scene,
+            &photo,
+            &water,
+            &[light(&plane, thin, 0), light(&plane, fragment, 1)],
+        );
+        assert_eq!(out.len(), 1, "the fragment merges");
+        assert_eq!(out[0].streak_ids, vec![0, 1]);
+        let got = out[0].rect();
+        let footprint = 10.0 * 2.0 * (30f32.to_radians()).tan() / photo.height as f32;
+        for (name, g, t) in [
+            ("left", got.u_min, truth.u_min),
+            ("right", got.u_max, truth.u_max),
+            ("bottom", got.v_min, truth.v_min),
+            ("top", got.v_max, truth.v_max),
+        ] {
+            assert!(
+                (g - t).abs() < footprint,
+                "{name} edge {g} against {t} (a pixel is {footprint} m)"
+            );
+        }
+
+        let close = truth.grow(0.2);
+        let kept = direct_starts(&scene, &photo, &water, &[light(&plane, close, 0)]);
+        assert_eq!(kept.len(), 1);
+        assert_eq!(kept[0].rect(), close);
+    }
+
+    #[test]
+    fn groups_are_8_connected() {
+        // Width 5: (0,0),(1,1) touch diagonally; (4,0) is alone; (3,3),(4,3) touch.
+        let px = [0, 6, 4, 18, 19];
+        let mut g = groups_8(&px, 5);
+        g.iter_mut().for_each(|m| m.sort_unstable());
+        g.sort();
+        assert_eq!(g, vec![vec![0, 1], vec![2], vec![3, 4]]);
+    }
+
+    #[test]
+    fn overlap_is_intersection_over_union() {
+        let a = Rect {
+            u_min: 0.0,
+            u_max: 2.0,
+            v_min: 0.0,
+            v_max: 1.0,
+        };
+        let b = Rect {
+            u_min: 1.0,
+            u_max: 3.0,
+            v_min: 0.0,
+            v_max: 1.0,
+        };
+        assert!((overlap(&a, &b) - 1.0 / 3.0).abs() < 1e-6);
+        assert_eq!(overlap(&a, &a), 1.0);
+        let far = b.grow(-0.5);
+        assert_eq!(
+            overlap(
+                &a,
+                &Rect {
+                    u_min: 5.0,
+                    u_max: 6.0,
+                    ..far
+                }
+            ),
+            0.0
+        );
+    }
+}
