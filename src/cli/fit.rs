@@ -90,7 +90,7 @@ pub struct Args {
     pub samples: u32,
     /// Seed of every random number, 0 to 2^64-1: the same inputs and seed give the same
     /// output.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed)]
     pub seed: u64,
     /// Do not add emissive fallback quads for viewers without area lights.
     #[arg(long)]

@@ -9,6 +9,17 @@ use streaklight::{output_file, photo_out};
 use super::output::Output;
 use super::scene_args::SceneArgs;
 
+/// `render --help`'s epilogue.
+pub const AFTER_HELP: &str = concat!(
+    "Examples:\n  \
+     streaklight render lit.gltf -o check.png --exposure 0.1\n  \
+     streaklight render lit.glb -o check.exr --width 1200 --spp 256 --nits-scale 683\n\n\
+     Units: each pixel stores radiance times --exposure; a light's radiance is its intensity in \
+     the file divided by --nits-scale. A .png is 8-bit sRGB, clipped at 1; an .exr keeps the \
+     linear values.\n\n",
+    super::exit::exit_codes!()
+);
+
 /// Arguments of `streaklight render`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -33,7 +44,7 @@ pub struct Args {
     #[arg(long, value_name = "E", default_value_t = 1.0, value_parser = super::values::positive_f32)]
     pub exposure: f32,
     /// Seed of every random number, 0 to 2^64-1: the same seed gives the same image.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed)]
     pub seed: u64,
     /// Blinn-Phong gloss e of the water (dimensionless, > 0; typical 100-2000, rough to calm;
     /// the samples: 200-1000), overriding its material's roughness.

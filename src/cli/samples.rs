@@ -4,6 +4,14 @@ use std::path::PathBuf;
 
 use streaklight::samples;
 
+/// `samples --help`'s epilogue.
+pub const AFTER_HELP: &str = concat!(
+    "Examples:\n  \
+     streaklight samples --scenes-only\n  \
+     streaklight samples samples --photo table3.png --spp 64\n\n",
+    super::exit::exit_codes!()
+);
+
 /// Arguments of `streaklight samples`.
 #[derive(clap::Args)]
 pub struct Args {

@@ -90,6 +90,13 @@ pub fn count(s: &str) -> Result<u32, String> {
     }
 }
 
+/// A seed of the random numbers: any whole number from 0 to 2^64 - 1.
+pub fn seed(s: &str) -> Result<u64, String> {
+    s.trim()
+        .parse::<u64>()
+        .map_err(|_| format!("must be a whole number from 0 to {}, got {s}", u64::MAX))
+}
+
 /// A count as a `usize`.
 pub fn count_usize(s: &str) -> Result<usize, String> {
     count(s).map(|n| n as usize)
@@ -138,6 +145,8 @@ mod tests {
         assert_eq!(correlation("-1"), Ok(-1.0));
         assert_eq!(blur_sigma("50"), Ok(50.0));
         assert_eq!(count("1"), Ok(1));
+        assert_eq!(seed("18446744073709551615"), Ok(u64::MAX));
+        assert!(seed("-1").unwrap_err().contains("from 0 to"));
         assert_eq!(exposure("AUTO"), Ok(ExposureArg::Auto));
         assert_eq!(exposure("0.1"), Ok(ExposureArg::Value(0.1)));
         for bad in ["-1", "0", "nan", "inf", "x"] {
