@@ -42,7 +42,12 @@ const COMMANDS: [(&str, &[&str]); 7] = [
 const BAD_VALUES: [(&str, &str, &str, &str); 41] = [
     ("fit", "--exposure", "-1", "greater than 0 or \"auto\""),
     ("fit", "--exposure", "0", "greater than 0"),
-    ("fit", "--exposure", "often", "expected a number"),
+    (
+        "fit",
+        "--exposure",
+        "often",
+        "a number greater than 0 or \"auto\"",
+    ),
     ("fit", "--gloss", "-5", "greater than 0"),
     ("fit", "--ior", "1", "greater than 1"),
     ("fit", "--nits-scale", "0", "greater than 0"),
@@ -79,7 +84,7 @@ const BAD_VALUES: [(&str, &str, &str, &str); 41] = [
     ("render", "--height", "-600", "whole number from 1"),
     ("render", "--spp", "0", "whole number from 1"),
     ("render", "--exposure", "-0.1", "greater than 0"),
-    ("render", "--exposure", "auto", "expected a number"),
+    ("render", "--exposure", "auto", "a number greater than 0"),
     ("render", "--seed", "x", "whole number from 0"),
     ("render", "--gloss", "0", "greater than 0"),
     ("render", "--ior", "0.5", "greater than 1"),

@@ -179,6 +179,15 @@ fn fit_args(scene: &Path, photos: &[&Path], to: &[&str], exposure: &str) -> Vec<
     args
 }
 
+/// Asserts that `value` satisfies `schema/SCHEMA`.
+fn assert_valid(value: &serde_json::Value, schema: &str) {
+    let errors: Vec<String> = common::json::schema_validator(schema)
+        .iter_errors(value)
+        .map(|e| format!("{e} at {}", e.instance_path))
+        .collect();
+    assert!(errors.is_empty(), "{schema}: {errors:?}");
+}
+
 fn radiance(report: &serde_json::Value) -> [f64; 3] {
     let r = &report["lights"][0]["radiance"];
     [0, 1, 2].map(|k| r[k].as_f64().unwrap())
@@ -193,19 +202,28 @@ fn each_photo_gets_the_exposure_of_its_exif() {
     std::fs::write(&a, png_with_exif(&png, A)).unwrap();
     std::fs::write(&b, jpeg_with_exif(&photo, B)).unwrap();
     let out = dir.join("lit");
-    let (code, _, stderr) = run(&fit_args(
+    let (code, stdout, stderr) = run(&fit_args(
         &scene,
         &[&a, &b],
-        &["--out-dir", &arg(&out)],
+        &["--out-dir", &arg(&out), "--json"],
         "auto",
     ));
     assert_eq!(code, 0, "{stderr}");
-    for (name, settings, words) in [
+    let summary: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_valid(&summary, "summary.schema.json");
+    for (k, (name, settings, words)) in [
         ("a", A, "EXIF: 1/60 s, f/8, ISO 100"),
         ("b", B, "EXIF: 1/30 s, f/2.8, ISO 800"),
-    ] {
+    ]
+    .into_iter()
+    .enumerate()
+    {
         let report = read_json(&out.join(format!("{name}.report.json")));
+        assert_valid(&report, "report.schema.json");
         let s = &report["settings"];
+        let photo = &summary["photos"][k];
+        assert_eq!(photo["exposure"], s["exposure"], "{summary}");
+        assert_eq!(photo["exposure_source"], s["exposure_source"], "{summary}");
         let got = s["exposure"].as_f64().unwrap();
         let want = expected_exposure(settings);
         assert!(

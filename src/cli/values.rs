@@ -3,18 +3,14 @@
 //! taken for an unknown option. Each error says the accepted range; clap adds the option and
 //! the value ("invalid value '-1' for '--exposure <E|auto>': ...") and exits with code 2.
 
-/// A finite number, or an error naming what was given.
-fn number(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(format!("expected a number, got \"{s}\"")),
-    }
-}
-
-/// A finite number for which `ok` holds; `range` says which in the error.
+/// A finite number for which `ok` holds; `range` says which in the error (NaN and the
+/// infinities are numbers out of every range).
 fn number_where(s: &str, range: &str, ok: impl Fn(f64) -> bool) -> Result<f64, String> {
-    let v = number(s)?;
-    if ok(v) {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("must be {range}, got \"{s}\""))?;
+    if v.is_finite() && ok(v) {
         Ok(v)
     } else {
         Err(format!("must be {range}, got {s}"))
