@@ -149,7 +149,8 @@ mod tests {
             let e = positive_f32(bad).unwrap_err();
             assert!(e.contains(bad), "{e}");
         }
-        let cases: [(fn(&str) -> Result<f32, String>, &str, &str); 6] = [
+        type Parser = fn(&str) -> Result<f32, String>;
+        let cases: [(Parser, &str, &str); 6] = [
             (ior, "1", "greater than 1"),
             (unit_interval, "1.5", "from 0 to 1"),
             (unit_threshold, "1", "not including, 1"),
