@@ -11,20 +11,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-/// Runs the binary: (exit code, stdout, stderr).
-fn run(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_streaklight"))
-        .args(args)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!stderr.contains("panicked"), "panic on {args:?}: {stderr}");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr,
-    )
-}
+use common::cli::run_cli_code as run;
 
 /// The subcommands and the arguments each needs besides its options (files that need not
 /// exist: values are checked before anything is read).

@@ -8,8 +8,8 @@ mod common;
 
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
+use common::cli::run_cli_code as run;
 use common::cli::{arg, SAMPLES_ARG};
 use common::fit_case;
 use common::json::read_json;
@@ -136,21 +136,6 @@ fn jpeg_with_exif(png: &Path, s: Settings) -> Vec<u8> {
     out.extend(payload);
     out.extend(&jpeg[2..]);
     out
-}
-
-/// Runs the binary: (exit code, stdout, stderr).
-fn run(args: &[String]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_streaklight"))
-        .args(args)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!stderr.contains("panicked"), "panic on {args:?}: {stderr}");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr,
-    )
 }
 
 /// The fit tests' scene and photo, and a folder for this test's files.
