@@ -8,7 +8,6 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::fitting::FittedLight;
-use crate::photo_in;
 use crate::pipeline::{self, light_name, FitSettings, Input};
 use crate::progress::Reporter;
 use crate::report::{self, Files, Report};
@@ -16,6 +15,7 @@ use crate::scene_in::{self, AreaLight, LoadOptions, Scene};
 use crate::scene_out::{self, InputFiles, LightToWrite, WriteOptions};
 use crate::settings::{reword, Setting};
 use crate::{debug_pictures, output_file, Error, Result};
+use crate::{photo_exif, photo_in};
 
 pub use crate::pipeline::check_photo;
 
@@ -36,6 +36,9 @@ pub struct ConvertOptions<'a> {
     pub load: LoadOptions,
     /// Divides the photo's linear values.
     pub exposure: f32,
+    /// Take the exposure from the photo's EXIF instead of [`ConvertOptions::exposure`]
+    /// ([`crate::photo_exif`]); a photo without the EXIF it needs is refused.
+    pub exposure_from_exif: bool,
     /// How to fit.
     pub fit: FitSettings,
     /// Write emissive fallback quads under the lights.
@@ -70,6 +73,7 @@ impl ConvertOptions<'_> {
             debug_dir: None,
             load: LoadOptions::default(),
             exposure: 1.0,
+            exposure_from_exif: false,
             fit: FitSettings::default(),
             fallback_quads: true,
             light_offset: scene_out::DEFAULT_LIGHT_OFFSET,
@@ -214,6 +218,8 @@ pub fn convert_loaded(
     options: &ConvertOptions,
 ) -> Result<ConvertOutcome> {
     let progress = options.progress;
+    let (resolved, exposure_source) = exposure_of(options)?;
+    let options = &resolved;
     let photo = timed(&mut before, progress, "load photo", || {
         photo_in::load(&options.photo, options.exposure)
     })?;
@@ -280,6 +286,7 @@ pub fn convert_loaded(
             files: files(options, Some(&options.output)),
             settings: &options.fit,
             exposure: options.exposure,
+            exposure_source,
             nits_scale: options.load.nits_scale,
             timings_before: before,
             timings_after: after,
@@ -313,6 +320,23 @@ pub fn convert_loaded(
         lights: lit.lights,
         files_written,
     })
+}
+
+/// `options` with the exposure the photo is read with, and where that came from: the
+/// option's value, or the photo's EXIF ([`ConvertOptions::exposure_from_exif`]).
+fn exposure_of<'a>(options: &ConvertOptions<'a>) -> Result<(ConvertOptions<'a>, String)> {
+    if !options.exposure_from_exif {
+        return Ok((options.clone(), "given".into()));
+    }
+    let (exposure, source) = photo_exif::exposure_of(&options.photo)?;
+    Ok((
+        ConvertOptions {
+            exposure,
+            exposure_from_exif: false,
+            ..options.clone()
+        },
+        source,
+    ))
 }
 
 /// The world-space corner of a light for messages.

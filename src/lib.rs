@@ -58,6 +58,7 @@ pub mod error;
 pub mod fitting;
 pub mod optics;
 pub mod output_file;
+pub mod photo_exif;
 pub mod photo_in;
 pub mod photo_out;
 pub mod pipeline;

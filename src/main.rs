@@ -36,18 +36,21 @@ pub enum Command {
     #[command(allow_negative_numbers = true, after_help = cli::exit::SEGMENT_HELP)]
     Segment(cli::segment::Args),
     /// Render the water and the EXT_lights_area lights of a scene as its camera sees them.
-    #[command(allow_negative_numbers = true, after_help = cli::exit::OTHER_HELP)]
+    #[command(allow_negative_numbers = true, after_help = cli::render::AFTER_HELP)]
     Render(cli::render::Args),
     /// Put back the EXT_lights_area lights of a fit output from its fallback quads, after a
     /// tool without the extension dropped them.
-    #[command(after_help = cli::exit::OTHER_HELP)]
+    #[command(after_help = cli::restore_lights::AFTER_HELP)]
     RestoreLights(cli::restore_lights::Args),
     /// Write the sample scenes of the paper's setup and render their photos.
-    #[command(after_help = cli::exit::OTHER_HELP)]
+    #[command(allow_negative_numbers = true, after_help = cli::samples::AFTER_HELP)]
     Samples(cli::samples::Args),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell) on stdout.
     #[command(after_help = cli::completions::AFTER_HELP)]
     Completions(cli::completions::Args),
+    /// Write the manual pages: streaklight.1 and one streaklight-NAME.1 per command.
+    #[command(after_help = cli::man::AFTER_HELP)]
+    Man(cli::man::Args),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +63,7 @@ fn main() -> ExitCode {
         Command::Samples(args) => Exit::of(cli::samples::run(args, &out)),
         Command::Completions(args) => Exit::of(cli::completions::run::<Cli>(args)),
         Command::RestoreLights(args) => Exit::of(cli::restore_lights::run(args, &out)),
+        Command::Man(args) => Exit::of(cli::man::run::<Cli>(args, &out)),
     };
     exit.code()
 }

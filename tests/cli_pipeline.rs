@@ -6,28 +6,13 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
+use common::cli::run_cli_code as run;
 use common::cli::{arg, fit_args};
 use common::dirs::listing;
 use common::fit_case::{self, SIDE};
 use common::json::{read_json, schema_validator};
 use serde_json::Value;
-
-/// Runs the binary: (exit code, stdout, stderr).
-fn run(args: &[String]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_streaklight"))
-        .args(args)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!stderr.contains("panicked"), "panic on {args:?}: {stderr}");
-    (
-        out.status.code().expect("an exit code"),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr,
-    )
-}
 
 fn strings(args: &[&str]) -> Vec<String> {
     args.iter().map(|a| a.to_string()).collect()

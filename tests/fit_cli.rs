@@ -196,14 +196,14 @@ fn photo_problems_are_refused() {
         &scene,
         &close,
         &["--repeats", "0"],
-        &["--repeats", "0 is not in 1.."],
+        &["--repeats", "whole number from 1"],
     );
     expect_refusal(
         &dir,
         &scene,
         &close,
         &["--joint-samples", "0"],
-        &["--joint-samples", "0 is not in 1.."],
+        &["--joint-samples", "whole number from 1"],
     );
     // Missing.
     expect_refusal(

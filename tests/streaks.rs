@@ -361,7 +361,7 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
     );
     assert!(out_dark.join("streaks.json").is_file());
 
-    // A bad setting is refused before any work, naming the setting.
+    // A bad setting is refused as it is parsed, naming the option and its range.
     let (ok, _, stderr) = common::run_cli(&[
         "segment",
         scene.to_str().unwrap(),
@@ -371,5 +371,8 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
         "--seed-threshold",
         "2",
     ]);
-    assert!(!ok && stderr.contains("seed threshold"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("--seed-threshold") && stderr.contains("not including, 1"),
+        "{stderr}"
+    );
 }

@@ -11,10 +11,13 @@ pub struct Args {
 }
 
 /// `completions --help`'s epilogue.
-pub const AFTER_HELP: &str = "Examples:\n  \
-    streaklight completions bash > ~/.local/share/bash-completion/completions/streaklight\n  \
-    streaklight completions zsh > ~/.zfunc/_streaklight\n  \
-    streaklight completions fish > ~/.config/fish/completions/streaklight.fish";
+pub const AFTER_HELP: &str = concat!(
+    "Examples:\n  \
+     streaklight completions bash > ~/.local/share/bash-completion/completions/streaklight\n  \
+     streaklight completions zsh > ~/.zfunc/_streaklight\n  \
+     streaklight completions fish > ~/.config/fish/completions/streaklight.fish\n\n",
+    super::exit::exit_codes!()
+);
 
 /// Prints the script for the command line `C`.
 pub fn run<C: CommandFactory>(args: Args) -> streaklight::Result<()> {

@@ -93,6 +93,3 @@ pub const SEGMENT_HELP: &str = concat!(
     "Example:\n  streaklight segment samples/scene.gltf samples/table3.png --exposure 0.1 --out-dir streaks\n\n",
     exit_codes!()
 );
-
-/// The epilogue of the commands that find no lights.
-pub const OTHER_HELP: &str = exit_codes!();

@@ -14,16 +14,19 @@ use super::output::Output;
 use super::output_args::OutputArgs;
 use super::scene_args::SceneArgs;
 use super::streak_args::StreakArgs;
+use super::values::ExposureArg;
 
 /// `fit --help`'s epilogue.
 pub const AFTER_HELP: &str = concat!(
     "Examples:\n  \
      streaklight fit samples/scene.gltf samples/table3.png --exposure 0.1 -o lit.gltf --report report.json\n  \
-     streaklight fit scene.glb photo.jpg --exposure 0.05 --gloss auto -o lit.glb --debug-dir debug\n  \
+     streaklight fit scene.glb photo.jpg --exposure auto --nits-scale 683 --gloss auto -o lit.glb --debug-dir debug\n  \
      streaklight fit scene.gltf night1.png night2.png night3.png --exposure 0.1 --out-dir lit --json\n\n\
-     Typical values: --exposure 0.01-1 (the samples: 0.1); --gloss 100-2000 (rough to calm water; \
-     the samples: 500); --ior 1.33 (water); lights come out in metres (scene units) and radiance \
-     in the photo's linear units divided by the exposure.\n\n\
+     Units: lights come out in metres (the scene's units) and radiance in the photo's linear \
+     units divided by the exposure (with --exposure auto: W/(sr m^2)); the scene's light \
+     intensity is that radiance times --nits-scale. Typical values: --exposure 0.01-100 (the \
+     samples: 0.1); --gloss 100-2000 (rough to calm water; the samples: 500); --ior 1.33 \
+     (water).\n\n\
      Pipelines: --json prints one summary object on stdout (schema/summary.schema.json); \
      --report writes the full report (schema/report.schema.json), or, for a refused run, \
      a report saying why.\n\n",
@@ -67,20 +70,27 @@ pub struct Args {
     /// the files written (schema/summary.schema.json).
     #[arg(long)]
     pub json: bool,
-    /// Blinn-Phong gloss e of the water, overriding its material's roughness; or "auto" to
-    /// estimate it from the photo together with the lights (starting from the material's;
-    /// several joint fits, so a few times slower). Not with --method paper.
+    /// Blinn-Phong gloss e of the water (dimensionless, > 0; typical 100-2000, rough to calm;
+    /// the samples: 500), overriding its material's roughness; or "auto" to estimate it from
+    /// the photo together with the lights (starting from the material's; several joint fits,
+    /// so a few times slower). Not with --method paper.
     #[arg(long, value_name = "E|auto")]
     pub gloss: Option<GlossArg>,
-    /// The photo's exposure, > 0: its linear values are divided by it to give radiance (the
-    /// samples: 0.1).
-    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive_f32)]
-    pub exposure: f32,
-    /// Lobe samples per traced pixel.
-    #[arg(long, default_value_t = streaklight::fitting::DEFAULT_SAMPLES)]
+    /// The photo's exposure: its linear values are divided by it to give radiance, in the
+    /// unit the exposure assumes (> 0; typical 0.01-100; the samples: 0.1). "auto": computed
+    /// from the photo's EXIF exposure time, f-number and ISO speed by the reflected-light
+    /// meter equation (K = 12.5, the metered luminance at linear 0.18), giving radiance in
+    /// W/(sr m^2) (add --nits-scale 683 for lights in cd/m^2); each photo gets its own, and a
+    /// photo whose EXIF lacks them (or an EXR/HDR, which has none) is refused.
+    #[arg(long, value_name = "E|auto", default_value = "1", value_parser = super::values::exposure)]
+    pub exposure: ExposureArg,
+    /// Lobe samples per traced pixel of the per-streak estimate (1 or more; typical 64-2048;
+    /// its time grows in proportion).
+    #[arg(long, value_name = "N", default_value_t = streaklight::fitting::DEFAULT_SAMPLES, value_parser = super::values::count)]
     pub samples: u32,
-    /// Seed of every random number: the same inputs and seed give the same output.
-    #[arg(long, default_value_t = 1)]
+    /// Seed of every random number, 0 to 2^64-1: the same inputs and seed give the same
+    /// output.
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed)]
     pub seed: u64,
     /// Do not add emissive fallback quads for viewers without area lights.
     #[arg(long)]
@@ -101,15 +111,16 @@ pub struct Args {
     pub water_model: String,
     /// Run the joint fit this many times, each from its own samples, and report the mean: N
     /// times slower, about sqrt(N) times less of the samples' noise; the uncertainties add the
-    /// fits' spread (and so come out on the wide side).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    /// fits' spread (and so come out on the wide side). 1 or more; typical 1-8.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = super::values::count)]
     pub repeats: u32,
     /// Lobe samples per pixel of the joint fit, rounded to 8 b^2 (8, 32, 72, 128, 200, 288,
     /// ...; default 72, or 128 for the final fit of --gloss auto): the time grows with them
     /// and the fit's own noise falls, until the photo's own noise is what is left. Without
     /// this option and --all-pixels, lights the fit finds sharing a streak are fitted again
-    /// over every pixel with 128 samples; with either, they are not.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    /// over every pixel with 128 samples; with either, they are not. 1 or more; typical
+    /// 32-288.
+    #[arg(long, value_name = "N", value_parser = super::values::count)]
     pub joint_samples: Option<u32>,
     /// Fit every water pixel near the streaks instead of every second one (a checkerboard):
     /// about twice the joint fit's time, and less of both the samples' and the photo's noise
@@ -125,8 +136,9 @@ pub struct Args {
     pub no_direct_view: bool,
     /// How far in front of its wall each light is written, in metres, along the direction it
     /// emits: a light exactly in the wall's plane is shadowed by the wall in renderers that
-    /// trace shadow rays (Blender's Cycles among them). The report records it.
-    #[arg(long, value_name = "METRES", default_value_t = streaklight::scene_out::DEFAULT_LIGHT_OFFSET)]
+    /// trace shadow rays (Blender's Cycles among them). The report records it. 0 or more;
+    /// typical 0.001-0.01 (far below what a fit resolves).
+    #[arg(long, value_name = "METRES", default_value_t = streaklight::scene_out::DEFAULT_LIGHT_OFFSET, value_parser = super::values::non_negative_f64)]
     pub light_offset: f64,
     /// Output-file options.
     #[command(flatten)]
@@ -217,7 +229,8 @@ fn fit_all(args: &Args, out: &Output, summary: &mut Summary) -> streaklight::Res
             Some(GlossArg::Value(e)) => Some(e),
             _ => None,
         }),
-        exposure: args.exposure,
+        exposure: args.exposure.value_or_auto().0,
+        exposure_from_exif: args.exposure.value_or_auto().1,
         fallback_quads: !args.no_fallback_quads,
         light_offset: args.light_offset,
         input_files: args.files.input_files(),
@@ -266,6 +279,13 @@ fn tell(
     };
     for w in &outcome.report.warnings {
         out.warn(&format!("{prefix}{w}"));
+    }
+    let settings = &outcome.report.settings;
+    if settings.exposure_source != "given" {
+        out.info(&format!(
+            "{prefix}exposure {} ({}): radiance in W/(sr m^2)",
+            settings.exposure, settings.exposure_source
+        ));
     }
     for light in &outcome.report.lights {
         out.info(&format!(

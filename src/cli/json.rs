@@ -36,6 +36,9 @@ struct PhotoSummary {
     error: Option<String>,
     output: Option<String>,
     lights: usize,
+    /// The exposure the photo was read with, and where it came from (the report's).
+    exposure: Option<f32>,
+    exposure_source: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -130,6 +133,8 @@ impl Summary {
             error: None,
             output: Some(output.into()),
             lights: report.lights.len(),
+            exposure: Some(report.settings.exposure),
+            exposure_source: Some(report.settings.exposure_source.clone()),
         });
     }
 
@@ -143,6 +148,8 @@ impl Summary {
             error: Some(error),
             output: None,
             lights: 0,
+            exposure: None,
+            exposure_source: None,
         });
         self.worsen(exit);
     }

@@ -6,6 +6,7 @@ pub mod fit;
 pub mod fit_batch;
 pub mod flags;
 pub mod json;
+pub mod man;
 pub mod output;
 pub mod output_args;
 pub mod progress;

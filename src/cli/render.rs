@@ -9,6 +9,17 @@ use streaklight::{output_file, photo_out};
 use super::output::Output;
 use super::scene_args::SceneArgs;
 
+/// `render --help`'s epilogue.
+pub const AFTER_HELP: &str = concat!(
+    "Examples:\n  \
+     streaklight render lit.gltf -o check.png --exposure 0.1\n  \
+     streaklight render lit.glb -o check.exr --width 1200 --spp 256 --nits-scale 683\n\n\
+     Units: each pixel stores radiance times --exposure; a light's radiance is its intensity in \
+     the file divided by --nits-scale. A .png is 8-bit sRGB, clipped at 1; an .exr keeps the \
+     linear values.\n\n",
+    super::exit::exit_codes!()
+);
+
 /// Arguments of `streaklight render`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -17,24 +28,27 @@ pub struct Args {
     /// The image to write: .png (8-bit sRGB, clipped) or .exr (linear float).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 600)]
+    /// Image width in pixels, 1 or more (typical 300-2000).
+    #[arg(long, value_name = "PIXELS", default_value_t = 600, value_parser = super::values::count)]
     pub width: u32,
-    /// Image height in pixels; by default the width divided by the camera's aspect ratio.
-    #[arg(long)]
+    /// Image height in pixels, 1 or more; by default the width divided by the camera's
+    /// aspect ratio.
+    #[arg(long, value_name = "PIXELS", value_parser = super::values::count)]
     pub height: Option<u32>,
-    /// Camera rays per pixel.
-    #[arg(long, default_value_t = 64)]
+    /// Camera rays per pixel, 1 or more (typical 16-1024: the time grows in proportion, the
+    /// noise falls as its square root).
+    #[arg(long, value_name = "N", default_value_t = 64, value_parser = super::values::count)]
     pub spp: u32,
-    /// Multiplies radiance before it is stored (> 0; the samples use 0.1).
-    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive_f32)]
+    /// Multiplies radiance before it is stored: the stored linear value per unit of radiance
+    /// (> 0; typical 0.01-100; the samples use 0.1), as fit's --exposure divides by it.
+    #[arg(long, value_name = "E", default_value_t = 1.0, value_parser = super::values::positive_f32)]
     pub exposure: f32,
-    /// Seed of every random number: the same seed gives the same image.
-    #[arg(long, default_value_t = 1)]
+    /// Seed of every random number, 0 to 2^64-1: the same seed gives the same image.
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed)]
     pub seed: u64,
-    /// Blinn-Phong gloss e of the water, overriding its material's roughness (> 0; the
-    /// samples: 200-1000).
-    #[arg(long, value_parser = super::values::positive_f32)]
+    /// Blinn-Phong gloss e of the water (dimensionless, > 0; typical 100-2000, rough to calm;
+    /// the samples: 200-1000), overriding its material's roughness.
+    #[arg(long, value_name = "E", value_parser = super::values::positive_f32)]
     pub gloss: Option<f32>,
     /// Camera, water and units.
     #[command(flatten)]

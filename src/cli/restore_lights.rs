@@ -7,6 +7,14 @@ use streaklight::scene_out::restore_lights;
 use super::output::Output;
 use super::output_args::OutputArgs;
 
+/// `restore-lights --help`'s epilogue.
+pub const AFTER_HELP: &str = concat!(
+    "Example:\n  \
+     gltf-transform optimize lit.glb optimized.glb && \
+     streaklight restore-lights optimized.glb -o restored.glb\n\n",
+    super::exit::exit_codes!()
+);
+
 /// Arguments of `streaklight restore-lights`.
 #[derive(clap::Args)]
 pub struct Args {

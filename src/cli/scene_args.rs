@@ -13,12 +13,13 @@ pub struct SceneArgs {
     /// Water node or mesh name (default: the one mesh node whose name contains "water").
     #[arg(long)]
     pub water: Option<String>,
-    /// Index of refraction of the water, above 1 (default: its material's KHR_materials_ior,
-    /// else 1.33).
-    #[arg(long, value_parser = super::values::ior)]
+    /// Index of refraction of the water, above 1 (dimensionless; water 1.33, sea water 1.34;
+    /// default: its material's KHR_materials_ior, else 1.33).
+    #[arg(long, value_name = "N", value_parser = super::values::ior)]
     pub ior: Option<f32>,
-    /// Light intensity units per unit of radiance, > 0 (683 turns W/(sr m^2) into nits).
-    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive_f64)]
+    /// Light intensity units per unit of radiance, > 0: 1 keeps the photo's units, 683 (lm/W)
+    /// turns W/(sr m^2) into cd/m^2 (nits).
+    #[arg(long, value_name = "SCALE", default_value_t = 1.0, value_parser = super::values::positive_f64)]
     pub nits_scale: f64,
     /// Use Smith shadowing in the reflection model (default: the paper's G = 1).
     #[arg(long)]

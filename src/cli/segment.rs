@@ -6,7 +6,8 @@ use streaklight::scene_in::{self, LoadOptions};
 use streaklight::streaks::{self, pictures, report};
 
 use super::streak_args::StreakArgs;
-use streaklight::{photo_in, water_mask, Error};
+use super::values::ExposureArg;
+use streaklight::{photo_exif, photo_in, water_mask, Error};
 
 /// Arguments of `streaklight segment`.
 #[derive(clap::Args)]
@@ -16,11 +17,14 @@ pub struct Args {
     /// The photo of the water.
     pub photo: PathBuf,
     /// Folder for the pictures and streaks.json (created if missing).
-    #[arg(long)]
+    #[arg(long, value_name = "DIR")]
     pub out_dir: PathBuf,
-    /// Divides the photo's linear values to give radiance (> 0; the samples use 0.1).
-    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive_f32)]
-    pub exposure: f32,
+    /// Divides the photo's linear values to give radiance (> 0; typical 0.01-100; the
+    /// samples use 0.1), or "auto" from the photo's EXIF, as for `fit`. The streaks are found
+    /// on the photo's colours as they are; the exposure scales the radiance streaks.json
+    /// reports.
+    #[arg(long, value_name = "E|auto", default_value = "1", value_parser = super::values::exposure)]
+    pub exposure: ExposureArg,
     /// Camera node or camera name (default: the first camera of the default scene).
     #[arg(long)]
     pub camera: Option<String>,
@@ -36,7 +40,15 @@ pub struct Args {
 pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
     let params = args.streak.params()?;
 
-    let photo = photo_in::load(&args.photo, args.exposure)?;
+    let exposure = match args.exposure {
+        ExposureArg::Value(e) => e,
+        ExposureArg::Auto => {
+            let (e, source) = photo_exif::exposure_of(&args.photo)?;
+            out.info(&format!("exposure {e} ({source})"));
+            e
+        }
+    };
+    let photo = photo_in::load(&args.photo, exposure)?;
     let scene = scene_in::load(
         &args.scene,
         &LoadOptions {

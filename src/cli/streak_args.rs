@@ -5,26 +5,32 @@ use streaklight::streaks::StreakParams;
 /// Streak-extraction options (method §5 steps 3-5); the defaults work on the samples.
 #[derive(clap::Args)]
 pub struct StreakArgs {
-    /// Number of superpixels K (default: one per 400 pixels).
-    #[arg(long)]
+    /// Number of superpixels K, 1 or more (default: one per 400 pixels, e.g. 1200 for a
+    /// 800 x 600 photo; fewer, larger superpixels merge narrow streaks with the water).
+    #[arg(long, value_name = "K", value_parser = super::values::count_usize)]
     pub superpixels: Option<usize>,
-    /// SLIC compactness m.
-    #[arg(long, default_value_t = 10.0)]
+    /// SLIC compactness m, > 0 (typical 5-40: higher gives rounder superpixels that follow
+    /// the streaks' edges less).
+    #[arg(long, value_name = "M", default_value_t = 10.0, value_parser = super::values::positive_f32)]
     pub compactness: f32,
-    /// Seed search: every k-th row.
-    #[arg(long, default_value_t = 8)]
+    /// Seed search: every k-th row, 1 or more (typical 4-16; smaller finds shorter streaks
+    /// and takes longer).
+    #[arg(long, value_name = "K", default_value_t = 8, value_parser = super::values::count_usize)]
     pub seed_row_step: usize,
-    /// Seed threshold t on the value V (sRGB-encoded, 0 to 1).
-    #[arg(long, default_value_t = 0.35)]
+    /// Seed threshold t on the value V = max(R, G, B), sRGB-encoded, from 0 up to, not
+    /// including, 1 (typical 0.2-0.6; lower finds dimmer lights, and more false streaks).
+    #[arg(long, value_name = "T", default_value_t = 0.35, value_parser = super::values::unit_threshold)]
     pub seed_threshold: f32,
-    /// Gaussian blur sigma in pixels before the seed search.
-    #[arg(long, default_value_t = 1.5)]
+    /// Gaussian blur sigma before the seed search, in pixels, 0 to 50 (typical 0.5-3).
+    #[arg(long, value_name = "PIXELS", default_value_t = 1.5, value_parser = super::values::blur_sigma)]
     pub blur: f32,
-    /// Histogram correlation at or above which two superpixels are one streak (-1 to 1).
-    #[arg(long, default_value_t = 0.5)]
+    /// Histogram correlation at or above which two superpixels are one streak, -1 to 1
+    /// (typical 0.3-0.8; higher splits streaks more).
+    #[arg(long, value_name = "R", default_value_t = 0.5, value_parser = super::values::correlation)]
     pub similarity: f32,
-    /// Mean V below which a superpixel never joins a streak.
-    #[arg(long, default_value_t = 0.15)]
+    /// Mean V (sRGB-encoded, 0 to 1) below which a superpixel never joins a streak (typical
+    /// 0.05-0.3).
+    #[arg(long, value_name = "V", default_value_t = 0.15, value_parser = super::values::unit_interval)]
     pub min_value: f32,
 }
 

@@ -105,7 +105,7 @@ pub fn page(report: &Report, figures: &[Figure]) -> String {
          </style></head><body>\n\
          <h1>streaklight fit of {photo}</h1>\n\
          <p>Scene {scene}; output {output}; status: {status}. Gloss e = {gloss:.1} ({gloss_source}), \
-         IOR {ior}, exposure {exposure}, method {method}.</p>\n\
+         IOR {ior}, exposure {exposure} ({exposure_source}), method {method}.</p>\n\
          <h2>Lights ({n})</h2>\n<p>Lengths in metres (world coordinates), radiance in the photo's \
          linear units divided by the exposure; &plusmn; one sigma. L<i>k</i> is the light's \
          number in the pictures.</p>\n\
@@ -122,6 +122,7 @@ pub fn page(report: &Report, figures: &[Figure]) -> String {
         gloss_source = escape(&s.gloss_source),
         ior = s.ior,
         exposure = s.exposure,
+        exposure_source = escape(&s.exposure_source),
         method = escape(&s.method),
         n = report.lights.len(),
         nw = report.warnings.len(),

@@ -18,6 +18,8 @@ pub struct Run<'a> {
     pub settings: &'a FitSettings,
     /// Divisor applied to the photo's linear values.
     pub exposure: f32,
+    /// Where the exposure came from: "given", or the photo's EXIF settings.
+    pub exposure_source: String,
     /// Intensity units per unit of radiance in the written lights.
     pub nits_scale: f64,
     /// Wall-clock seconds of the stages outside the fit, before it and after it.
@@ -69,6 +71,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
                 }
             }),
             exposure: run.exposure,
+            exposure_source: run.exposure_source,
             nits_scale: run.nits_scale,
             light_offset: None,
             method: settings.method.name().into(),

@@ -77,8 +77,12 @@ pub struct Settings {
     /// Which pixels of its region the (final) joint fit read: "checkerboard" (every second
     /// one, the default) or "all" ([`crate::pipeline::Reading::all_pixels`]); `None` for the paper method.
     pub joint_pixels: Option<String>,
-    /// Divisor applied to the photo's linear values.
+    /// Divisor applied to the photo's linear values: linear value per unit of radiance.
     pub exposure: f32,
+    /// Where the exposure came from: "given" (the caller's value), or "EXIF: 1/30 s, f/2.8,
+    /// ISO 800, ..." when computed from the photo's camera settings
+    /// ([`crate::photo_exif`]; the radiance is then in W/(sr m^2)).
+    pub exposure_source: String,
     /// Intensity units per unit of radiance in the written lights.
     pub nits_scale: f64,
     /// How far (metres) each light's node was written in front of its fitted rectangle,

@@ -23,6 +23,22 @@ pub fn run_cli<S: AsRef<OsStr>>(args: &[S]) -> (bool, String, String) {
     )
 }
 
+/// Runs the streaklight binary and asserts that it did not panic; returns (exit code, stdout,
+/// stderr).
+pub fn run_cli_code<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_streaklight"))
+        .args(args)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "panic on {args:?}: {stderr}");
+    (
+        out.status.code().expect("an exit code"),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr,
+    )
+}
+
 /// `p` as a command-line argument.
 pub fn arg(p: &Path) -> String {
     p.to_str().unwrap().to_owned()
