@@ -118,7 +118,7 @@ pub const MAX_DECODE_BYTES: u64 = 2 << 30;
 /// Reads and decodes the photo at `path`; `exposure` divides the linear values (method §2).
 pub fn load(path: &Path, exposure: f32) -> Result<Photo> {
     check_exposure(exposure)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input_file::read(path)?;
     decode(&bytes, exposure, path)
 }
 

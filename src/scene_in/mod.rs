@@ -110,7 +110,7 @@ fn check_options(options: &LoadOptions) -> Result<()> {
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
     // A bad option is reported before a missing file.
     check_options(options)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input_file::read(path)?;
     load_from_bytes(
         &bytes,
         Some(path.parent().unwrap_or(Path::new("."))),

@@ -34,6 +34,17 @@ use edit::{array_mut, len_of, object_mut, push, root_mut, use_extension};
 pub use lights::EXTENSION;
 pub use restore::{restore_lights, RestoreSummary};
 
+/// The files writing the scene `input` as `output` reads (the input and the local buffer and
+/// image files it refers to) and writes (the output and the files beside it), known before
+/// any work: the caller checks them against its own inputs and outputs.
+pub fn planned_files(
+    input: &Path,
+    output: &Path,
+    files: InputFiles,
+) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
+    staged::planned_files(input, output, files)
+}
+
 /// One fitted light, in world space, as the fitter hands it over.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightToWrite {
