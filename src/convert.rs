@@ -132,9 +132,24 @@ pub fn check_output(options: &ConvertOptions) -> Result<Vec<PathBuf>> {
     output_file::ensure_not_an_input(&options.output, &direct)?;
     output_file::ensure_writable(&options.output)?;
     // A scene that cannot be read is refused by the load, with a report saying why.
-    let (mut reads, mut writes) =
-        scene_out::planned_files(&options.scene, &options.output, options.input_files)
-            .unwrap_or_else(|_| (vec![options.scene.clone()], vec![options.output.clone()]));
+    let plan = scene_out::plan(&options.scene, &options.output, options.input_files)
+        .unwrap_or_else(|_| scene_out::Plan {
+            reads: vec![options.scene.clone()],
+            writes: vec![options.output.clone()],
+            own_lights: Vec::new(),
+        });
+    if let Some(first) = plan.own_lights.first() {
+        return Err(Error::scene(
+            &options.scene,
+            format!(
+                "it already holds {} light(s) that streaklight fitted (\"{first}\" ...; nodes \
+                 marked in extras.streaklight): a new fit would add a second set beside them. \
+                 Fit the scene they were fitted into, or remove those nodes first",
+                plan.own_lights.len()
+            ),
+        ));
+    }
+    let (mut reads, mut writes) = (plan.reads, plan.writes);
     reads.push(options.photo.clone());
     if let Some(report) = &options.report {
         // Checked now, so a missing or read-only report folder cannot leave a scene written
@@ -252,6 +267,7 @@ pub fn convert_loaded(
     })?;
     check_photo(scene, &photo, &options.photo)?;
     let mut lit = pipeline::fit(scene, &photo, &options.fit, progress)?;
+    lit.warnings.extend(photo.warnings.iter().cloned());
     let word = |text: &str| reword(text, options.wording);
     if let Some((about, why)) = &lit.nothing_found {
         let message = format!(

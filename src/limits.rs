@@ -42,16 +42,17 @@ pub fn max_input_bytes() -> crate::Result<u64> {
 }
 
 /// Refuses, before any work, a run whose memory estimate `bytes` is above the limit
-/// ([`MAX_MEMORY_MB_VAR`]); `what` completes "the fit of ... would need".
-pub fn check_memory(bytes: u64, what: &str) -> crate::Result<()> {
-    let limit = megabytes(MAX_MEMORY_MB_VAR, DEFAULT_MAX_MEMORY_MB)?;
+/// ([`MAX_MEMORY_MB_VAR`]): the message completes "`what` would need ...".
+pub fn check_memory(bytes: u64, what: &str) -> crate::Result<(), String> {
+    let limit = megabytes(MAX_MEMORY_MB_VAR, DEFAULT_MAX_MEMORY_MB).map_err(|e| e.to_string())?;
     if bytes > limit {
-        return Err(crate::Error::Usage(format!(
-            "{what} would need about {} MiB of memory, above the limit of {} MiB; set the \
+        let mib = |b: u64| b as f64 / f64::from(1u32 << 20);
+        return Err(format!(
+            "{what} would need about {:.1} MiB of memory, above the limit of {:.0} MiB; set the \
              environment variable {MAX_MEMORY_MB_VAR} to raise it",
-            bytes >> 20,
-            limit >> 20
-        )));
+            mib(bytes),
+            mib(limit)
+        ));
     }
     Ok(())
 }

@@ -14,13 +14,32 @@ pub fn escaped(name: &str) -> String {
             out.push_str("...");
             break;
         }
-        if c.is_control() || matches!(c, '\u{2028}' | '\u{2029}' | '\u{202a}'..='\u{202e}') {
+        if needs_escape(c) {
             out.extend(c.escape_default());
         } else {
             out.push(c);
         }
     }
     out
+}
+
+/// A whole message for the terminal: every control character but the line breaks escaped,
+/// whatever name or file content it quotes.
+pub fn for_terminal(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c != '\n' && needs_escape(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Control characters, and the Unicode ones that move or reorder text.
+fn needs_escape(c: char) -> bool {
+    c.is_control() || matches!(c, '\u{2028}' | '\u{2029}' | '\u{202a}'..='\u{202e}')
 }
 
 #[cfg(test)]
@@ -37,5 +56,6 @@ mod tests {
             escaped(&"n".repeat(500)).chars().count(),
             MAX_PRINTED_CHARS + 3
         );
+        assert_eq!(for_terminal("a\u{1b}]0;x\u{7}\nb"), "a\\u{1b}]0;x\\u{7}\nb");
     }
 }

@@ -190,9 +190,15 @@ fn write(path: &Path, bytes: &[u8], last: bool) -> Result<()> {
     prefix.push(".");
     // Created and registered under the lock: an interrupt finds every temporary.
     let mut live = interrupt::live();
-    let temp = tempfile::Builder::new()
-        .prefix(&prefix)
-        .suffix(".tmp-streaklight")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp-streaklight");
+    // As a file created the ordinary way (0666 less the umask), not a temporary's 0600.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let temp = builder
         .tempfile_in(folder_of(path))
         .map_err(|e| Error::io(path, e))?;
     let temp_path = temp.path().to_path_buf();

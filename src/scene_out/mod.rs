@@ -34,15 +34,22 @@ use edit::{array_mut, len_of, object_mut, push, root_mut, use_extension};
 pub use lights::EXTENSION;
 pub use restore::{restore_lights, RestoreSummary};
 
-/// The files writing the scene `input` as `output` reads (the input and the local buffer and
-/// image files it refers to) and writes (the output and the files beside it), known before
-/// any work: the caller checks them against its own inputs and outputs.
-pub fn planned_files(
-    input: &Path,
-    output: &Path,
-    files: InputFiles,
-) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
-    staged::planned_files(input, output, files)
+/// What writing the scene `input` as `output` involves, known before any work.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Plan {
+    /// The files it reads: the input and the local buffer and image files it refers to.
+    pub reads: Vec<PathBuf>,
+    /// The files it may write: the output and the files beside it.
+    pub writes: Vec<PathBuf>,
+    /// The names of the lights a run of streaklight already wrote into the input (nodes
+    /// marked `extras.streaklight.role = "light"`).
+    pub own_lights: Vec<String>,
+}
+
+/// Reads `input` and tells what writing it as `output` involves: the caller checks the files
+/// against its own inputs and outputs before any work.
+pub fn plan(input: &Path, output: &Path, files: InputFiles) -> Result<Plan> {
+    staged::plan(input, output, files)
 }
 
 /// One fitted light, in world space, as the fitter hands it over.

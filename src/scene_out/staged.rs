@@ -286,14 +286,22 @@ pub(crate) fn bin_chunk_buffer(doc: &Document, input: &Path) -> Result<Option<Ve
     Ok(Some(bytes.to_vec()))
 }
 
-/// The files writing `input` as `output` reads (the input and the local files it refers to)
-/// and writes (the output, the copies beside it and its data file), known before any work.
-pub(crate) fn planned_files(
-    input: &Path,
-    output: &Path,
-    files: InputFiles,
-) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
+/// What writing `input` as `output` involves, known before any work (see [`super::Plan`]).
+pub(crate) fn plan(input: &Path, output: &Path, files: InputFiles) -> Result<super::Plan> {
     let doc = document::read(input)?;
+    let own_lights = doc
+        .json
+        .get("nodes")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .filter(|n| n.pointer("/extras/streaklight/role") == Some(&json!("light")))
+        .map(|n| {
+            n.get("name")
+                .and_then(Value::as_str)
+                .map_or_else(|| "unnamed".into(), crate::names::escaped)
+        })
+        .collect();
     let input_dir = folder_of(input)
         .canonicalize()
         .map_err(|e| Error::io(input, e))?;
@@ -315,5 +323,9 @@ pub(crate) fn planned_files(
             }
         }
     }
-    Ok((reads, writes))
+    Ok(super::Plan {
+        reads,
+        writes,
+        own_lights,
+    })
 }
