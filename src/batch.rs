@@ -51,6 +51,14 @@ pub fn convert_all(template: &ConvertOptions, jobs: &[Job]) -> Result<Vec<Result
                 .try_for_each(|w| output_file::ensure_not_an_input(w, &photos))
         })
         .collect();
+    if checked.iter().all(Result::is_err) {
+        // Nothing to do: no scene load either.
+        return Ok(checked
+            .into_iter()
+            .filter_map(Result::err)
+            .map(Err)
+            .collect());
+    }
     // Every file read from here on (the scene, its buffers, the photos) is kept from being
     // written over, and each photo's outputs are committed together or not at all.
     let _run = output_file::Run::begin();

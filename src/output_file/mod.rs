@@ -270,6 +270,40 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn outputs_get_the_permissions_of_an_ordinary_new_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let ordinary = dir.path().join("ordinary");
+        std::fs::write(&ordinary, b"x").unwrap();
+        let ours = dir.path().join("ours");
+        write_atomically(&ours, b"x").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&ours), mode(&ordinary));
+    }
+
+    #[test]
+    fn a_run_commits_together_or_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a"), dir.path().join("sub/b"));
+        {
+            let _run = Run::begin();
+            create_dir_all(&dir.path().join("sub")).unwrap();
+            write_atomically(&a, b"a").unwrap();
+            write_atomically(&b, b"b").unwrap();
+            // Not committed: dropped.
+        }
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+        let run = Run::begin();
+        write_atomically(&a, b"a").unwrap();
+        assert!(!a.exists(), "renamed before the commit");
+        let again = write_atomically(&dir.path().join(".").join("a"), b"c");
+        assert!(again.unwrap_err().to_string().contains("same file"));
+        assert_eq!(run.commit().unwrap(), vec![a.clone()]);
+        assert_eq!(std::fs::read(&a).unwrap(), b"a");
+    }
+
     #[test]
     fn atomic_write_replaces_and_leaves_no_temporary() {
         let dir = std::env::temp_dir().join(format!("streaklight-aw-{}", std::process::id()));

@@ -125,6 +125,15 @@ pub const MAX_NITS_SCALE: f64 = 1e9;
 /// overflow or lose every detail (georeferenced scenes are well within it).
 pub const MAX_CAMERA_DISTANCE: f64 = 1e9;
 
+/// A coordinate for a message: in exponent form when large (1e308 has 309 digits).
+fn short(v: f64) -> String {
+    if v.abs() < 1e6 {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Loads the scene at `path` (`.gltf` or `.glb`).
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
     // A bad option is reported before a missing file.
@@ -166,9 +175,11 @@ pub fn load_from_bytes(
         return Err(Error::scene(
             path,
             format!(
-                "the camera \"{name}\" is at ({:e}, {:e}, {:e}): a camera must be within \
+                "the camera \"{name}\" is at ({}, {}, {}): a camera must be within \
                  {MAX_CAMERA_DISTANCE:e} of the scene's origin (and finite)",
-                origin.x, origin.y, origin.z
+                short(origin.x),
+                short(origin.y),
+                short(origin.z)
             ),
         ));
     }

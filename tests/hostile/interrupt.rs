@@ -32,12 +32,21 @@ fn symlinks_planted_at_every_output_name_are_never_followed() {
     let args = fit(
         &c.scene,
         &c.photo,
-        &["-o", &arg(&c.dir.join("out.gltf")), "--report", &arg(&c.dir.join("report.json"))],
+        &[
+            "-o",
+            &arg(&c.dir.join("out.gltf")),
+            "--report",
+            &arg(&c.dir.join("report.json")),
+        ],
     );
     let ran = run_with(&args, &[], 60.0);
     assert_eq!(ran.code, Some(0), "{}", ran.stderr);
     for name in OUTPUTS {
-        assert_eq!(std::fs::read(victims.join(name)).unwrap(), b"precious", "{name}");
+        assert_eq!(
+            std::fs::read(victims.join(name)).unwrap(),
+            b"precious",
+            "{name}"
+        );
         let meta = std::fs::symlink_metadata(c.dir.join(name)).unwrap();
         assert!(meta.is_file(), "{name} is still a link");
     }

@@ -11,7 +11,11 @@ use crate::support::{case, fit, refused};
 fn a_report_over_the_scenes_own_buffer_is_refused() {
     let c = case("hostile-report-on-buffer");
     let out = c.dir.join("out.gltf");
-    let args = fit(&c.scene, &c.photo, &["-o", &arg(&out), "--report", &arg(&c.bin)]);
+    let args = fit(
+        &c.scene,
+        &c.photo,
+        &["-o", &arg(&out), "--report", &arg(&c.bin)],
+    );
     let ran = refused(&args, &[], &[&c.dir], &["water.bin", "input"]);
     assert!(ran.seconds < 5.0, "refused after {} s", ran.seconds);
 }
@@ -22,7 +26,11 @@ fn a_report_over_the_outputs_own_side_file_is_refused() {
     let out = c.dir.join("out.gltf");
     for side in ["out.buffer0.bin", "out.streaklight.bin"] {
         let report = c.dir.join(side);
-        let args = fit(&c.scene, &c.photo, &["-o", &arg(&out), "--report", &arg(&report)]);
+        let args = fit(
+            &c.scene,
+            &c.photo,
+            &["-o", &arg(&out), "--report", &arg(&report)],
+        );
         refused(&args, &[], &[&c.dir], &[side, "same file"]);
     }
 }
@@ -66,7 +74,11 @@ fn a_debug_folder_holding_an_input_named_like_a_picture_is_refused() {
     let photo = debug.join("streaks.png");
     std::fs::rename(&c.photo, &photo).unwrap();
     let out = c.dir.join("out.gltf");
-    let args = fit(&c.scene, &photo, &["-o", &arg(&out), "--debug-dir", &arg(&debug)]);
+    let args = fit(
+        &c.scene,
+        &photo,
+        &["-o", &arg(&out), "--debug-dir", &arg(&debug)],
+    );
     refused(&args, &[], &[&c.dir], &["streaks.png", "input"]);
 }
 
@@ -121,7 +133,14 @@ fn outputs_that_are_one_file_spelled_two_ways_are_refused() {
     let args = fit(
         &c.scene,
         &c.photo,
-        &["-o", &arg(&out), "--report", &arg(&report), "--debug-dir", &arg(&debug)],
+        &[
+            "-o",
+            &arg(&out),
+            "--report",
+            &arg(&report),
+            "--debug-dir",
+            &arg(&debug),
+        ],
     );
     refused(&args, &[], &[&c.dir], &["index.html", "same file"]);
 }

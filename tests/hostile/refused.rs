@@ -12,12 +12,20 @@ fn a_debug_folder_that_is_a_file_is_refused_before_any_work() {
     let out = c.dir.join("out.gltf");
     let not_a_folder = c.dir.join("debug");
     std::fs::write(&not_a_folder, b"a file").unwrap();
-    let args = fit(&c.scene, &c.photo, &["-o", &arg(&out), "--debug-dir", &arg(&not_a_folder)]);
+    let args = fit(
+        &c.scene,
+        &c.photo,
+        &["-o", &arg(&out), "--debug-dir", &arg(&not_a_folder)],
+    );
     let ran = refused(&args, &[], &[&c.dir], &["debug", "not a folder"]);
     // Before the scene is even loaded: no stage ran.
     assert!(ran.seconds < 1.0, "{} s", ran.seconds);
     // The output itself as the debug folder.
-    let args = fit(&c.scene, &c.photo, &["-o", &arg(&out), "--debug-dir", &arg(&out)]);
+    let args = fit(
+        &c.scene,
+        &c.photo,
+        &["-o", &arg(&out), "--debug-dir", &arg(&out)],
+    );
     refused(&args, &[], &[&c.dir], &["out.gltf"]);
 }
 
@@ -28,7 +36,15 @@ fn a_failure_after_writing_began_leaves_the_old_outputs() {
     let c = case("hostile-late-failure");
     let out = c.dir.join("out.gltf");
     let report = c.dir.join("report.json");
-    let first = run_with(&fit(&c.scene, &c.photo, &["-o", &arg(&out), "--report", &arg(&report)]), &[], 60.0);
+    let first = run_with(
+        &fit(
+            &c.scene,
+            &c.photo,
+            &["-o", &arg(&out), "--report", &arg(&report)],
+        ),
+        &[],
+        60.0,
+    );
     assert_eq!(first.code, Some(0), "{}", first.stderr);
     let debug = c.dir.join("debug");
     std::fs::create_dir_all(debug.join("streaks.png")).unwrap();

@@ -39,7 +39,12 @@ fn fifos_and_devices_are_refused_within_a_second() {
         serde_json::from_slice(&std::fs::read(&c.scene).unwrap()).unwrap();
     doc["buffers"][0]["uri"] = "/dev/zero".into();
     std::fs::write(&c.scene, serde_json::to_vec(&doc).unwrap()).unwrap();
-    let ran = refused(&fit(&c.scene, &c.photo, &["-o", &arg(&out)]), &[], &[&c.dir], &["device"]);
+    let ran = refused(
+        &fit(&c.scene, &c.photo, &["-o", &arg(&out)]),
+        &[],
+        &[&c.dir],
+        &["device"],
+    );
     assert!(ran.seconds < 1.0, "{} s", ran.seconds);
 }
 
@@ -49,18 +54,30 @@ fn the_input_and_memory_limits_refuse_and_say_how_to_raise_them() {
     let out = c.dir.join("out.gltf");
     let args = fit(&c.scene, &c.photo, &["-o", &arg(&out)]);
     // The scene's buffer is some 100 KB: a limit of 0 is refused as a value, 1 MiB passes it.
-    refused(&args, &[("STREAKLIGHT_MAX_INPUT_MB", "0")], &[&c.dir], &["STREAKLIGHT_MAX_INPUT_MB"]);
+    refused(
+        &args,
+        &[("STREAKLIGHT_MAX_INPUT_MB", "0")],
+        &[&c.dir],
+        &["STREAKLIGHT_MAX_INPUT_MB"],
+    );
     let big = c.dir.join("big.png");
     let noise: Vec<u8> = (0..900 * 900 * 3u32)
         .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
         .collect();
-    image::RgbImage::from_raw(900, 900, noise).unwrap().save(&big).unwrap();
+    image::RgbImage::from_raw(900, 900, noise)
+        .unwrap()
+        .save(&big)
+        .unwrap();
     let args = fit(&c.scene, &big, &["-o", &arg(&out)]);
     refused(
         &args,
         &[("STREAKLIGHT_MAX_INPUT_MB", "1")],
         &[&c.dir],
-        &["big.png", "larger than the input limit of 1 MiB", "STREAKLIGHT_MAX_INPUT_MB"],
+        &[
+            "big.png",
+            "larger than the input limit of 1 MiB",
+            "STREAKLIGHT_MAX_INPUT_MB",
+        ],
     );
     // The 160 x 160 photo needs about 1.2 MiB by the estimate.
     let args = fit(&c.scene, &c.photo, &["-o", &arg(&out)]);
@@ -79,7 +96,14 @@ fn options_above_their_caps_are_refused_before_any_work() {
     let scene = arg(&c.scene);
     let image = arg(&c.dir.join("r.png"));
     let cases: Vec<(Vec<String>, &str)> = vec![
-        (fit(&c.scene, &c.photo, &["-o", &out, "--joint-samples", "4294967295"]), "--joint-samples 4294967295"),
+        (
+            fit(
+                &c.scene,
+                &c.photo,
+                &["-o", &out, "--joint-samples", "4294967295"],
+            ),
+            "--joint-samples 4294967295",
+        ),
         (
             fit(&c.scene, &c.photo, &["-o", &out])
                 .into_iter()
@@ -87,23 +111,37 @@ fn options_above_their_caps_are_refused_before_any_work() {
                 .collect(),
             "--samples 4000000000",
         ),
-        (fit(&c.scene, &c.photo, &["-o", &out, "--repeats", "100000"]), "--repeats 100000"),
         (
-            ["render", &scene, "-o", &image, "--width", "32768", "--height", "32768"].map(String::from).to_vec(),
+            fit(&c.scene, &c.photo, &["-o", &out, "--repeats", "100000"]),
+            "--repeats 100000",
+        ),
+        (
+            [
+                "render", &scene, "-o", &image, "--width", "32768", "--height", "32768",
+            ]
+            .map(String::from)
+            .to_vec(),
             "--width 32768",
         ),
         (
-            ["render", &scene, "-o", &image, "--spp", "100000000"].map(String::from).to_vec(),
+            ["render", &scene, "-o", &image, "--spp", "100000000"]
+                .map(String::from)
+                .to_vec(),
             "--spp 100000000",
         ),
         (
-            ["render", &scene, "-o", &image, "--width", "8000", "--height", "8000", "--spp", "60000"]
-                .map(String::from)
-                .to_vec(),
+            [
+                "render", &scene, "-o", &image, "--width", "8000", "--height", "8000", "--spp",
+                "60000",
+            ]
+            .map(String::from)
+            .to_vec(),
             "camera rays",
         ),
         (
-            ["samples", &arg(&c.dir.join("s")), "--spp", "4000000000"].map(String::from).to_vec(),
+            ["samples", &arg(&c.dir.join("s")), "--spp", "4000000000"]
+                .map(String::from)
+                .to_vec(),
             "--spp 4000000000",
         ),
     ];
