@@ -109,7 +109,7 @@ fn check_options(options: &LoadOptions) -> Result<()> {
             format!(
                 "must be at most {MAX_NITS_SCALE:e} (683 turns W/(sr m^2) into nits), not {}: \
                  the lights' intensities would overflow",
-                options.nits_scale
+                short(options.nits_scale)
             ),
         ));
     }

@@ -8,7 +8,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::common::cli::arg;
-use crate::support::{case, fit, run_with, temporaries};
+use crate::support::{case, fit, run_with, temporaries, Case};
 
 /// The files a `-o out.gltf --report report.json` fit of a case writes.
 const OUTPUTS: [&str; 4] = [
@@ -17,6 +17,17 @@ const OUTPUTS: [&str; 4] = [
     "out.streaklight.bin",
     "report.json",
 ];
+
+/// The `fit` of case `c` that writes [`OUTPUTS`], with `seed`.
+fn outputs_fit(c: &Case, seed: &str) -> Vec<String> {
+    let out = arg(&c.dir.join(OUTPUTS[0]));
+    let report = arg(&c.dir.join(OUTPUTS[3]));
+    fit(
+        &c.scene,
+        &c.photo,
+        &["-o", &out, "--report", &report, "--seed", seed],
+    )
+}
 
 #[cfg(unix)]
 #[test]
@@ -29,17 +40,7 @@ fn symlinks_planted_at_every_output_name_are_never_followed() {
         std::fs::write(&victim, b"precious").unwrap();
         std::os::unix::fs::symlink(&victim, c.dir.join(name)).unwrap();
     }
-    let args = fit(
-        &c.scene,
-        &c.photo,
-        &[
-            "-o",
-            &arg(&c.dir.join("out.gltf")),
-            "--report",
-            &arg(&c.dir.join("report.json")),
-        ],
-    );
-    let ran = run_with(&args, &[], 60.0);
+    let ran = run_with(&outputs_fit(&c, "1"), &[], 60.0);
     assert_eq!(ran.code, Some(0), "{}", ran.stderr);
     for name in OUTPUTS {
         assert_eq!(
@@ -92,20 +93,7 @@ fn interrupted(dir: &Path, args: &[String], temps: usize, signal: i32) -> Option
 #[test]
 fn an_interrupt_in_the_write_stage_leaves_old_or_new_outputs_complete() {
     let c = case("hostile-interrupt");
-    let args_for = |seed: &str| {
-        fit(
-            &c.scene,
-            &c.photo,
-            &[
-                "-o",
-                &arg(&c.dir.join("out.gltf")),
-                "--report",
-                &arg(&c.dir.join("report.json")),
-                "--seed",
-                seed,
-            ],
-        )
-    };
+    let args_for = |seed: &str| outputs_fit(&c, seed);
     // The new outputs, as an uninterrupted run writes them.
     let reference = run_with(&args_for("2"), &[], 60.0);
     assert_eq!(reference.code, Some(0), "{}", reference.stderr);
