@@ -46,13 +46,22 @@ pub fn convert_all(template: &ConvertOptions, jobs: &[Job]) -> Result<Vec<Result
     let checked: Vec<Result<()>> = options
         .iter()
         .map(|o| {
-            check_output(o)?;
-            output_file::ensure_not_an_input(&o.output, &photos)?;
-            o.report
-                .as_ref()
-                .map_or(Ok(()), |r| output_file::ensure_not_an_input(r, &photos))
+            check_output(o)?
+                .iter()
+                .try_for_each(|w| output_file::ensure_not_an_input(w, &photos))
         })
         .collect();
+    if checked.iter().all(Result::is_err) {
+        // Nothing to do: no scene load either.
+        return Ok(checked
+            .into_iter()
+            .filter_map(Result::err)
+            .map(Err)
+            .collect());
+    }
+    // Every file read from here on (the scene, its buffers, the photos) is kept from being
+    // written over, and each photo's outputs are committed together or not at all.
+    let _run = output_file::Run::begin();
     let progress = template.progress;
     let start = Instant::now();
     progress.stage("load scene");
@@ -97,7 +106,7 @@ fn check_distinct(jobs: &[Job]) -> Result<()> {
             .chain(&j.report)
             .chain(&j.debug_dir);
         for p in paths {
-            if !seen.insert(p.clone()) {
+            if !seen.insert(output_file::identity(p)) {
                 return Err(Error::output(
                     p,
                     "two photos of the batch would write this same file; name their outputs apart",

@@ -110,8 +110,11 @@ fn timed<T>(
     out
 }
 
-/// Checks the output paths before any work, so a long run does not end in a refusal.
-pub fn check_output(options: &ConvertOptions) -> Result<()> {
+/// Checks the output paths before any work, so a long run does not end in a refusal: every
+/// output's folder can take it, and no file the run writes (the scene, the files beside it,
+/// the report, the debug pictures) is a file it reads (the scene, its buffers and images, the
+/// photo) or another of its outputs, however spelled. Returns the files the run writes.
+pub fn check_output(options: &ConvertOptions) -> Result<Vec<PathBuf>> {
     let ext = options
         .output
         .extension()
@@ -129,19 +132,58 @@ pub fn check_output(options: &ConvertOptions) -> Result<()> {
             options.light_offset
         )));
     }
-    let inputs = [options.scene.as_path(), options.photo.as_path()];
-    output_file::ensure_not_an_input(&options.output, &inputs)?;
-    output_file::ensure_folder_exists(&options.output)?;
+    let direct = [options.scene.as_path(), options.photo.as_path()];
+    output_file::ensure_not_an_input(&options.output, &direct)?;
     output_file::ensure_writable(&options.output)?;
+    // A scene that cannot be read is refused by the load, with a report saying why.
+    let plan = scene_out::plan(&options.scene, &options.output, options.input_files)
+        .unwrap_or_else(|_| scene_out::Plan {
+            reads: vec![options.scene.clone()],
+            writes: vec![options.output.clone()],
+            own_lights: Vec::new(),
+        });
+    if let Some(first) = plan.own_lights.first() {
+        return Err(Error::scene(
+            &options.scene,
+            format!(
+                "it already holds {} light(s) that streaklight fitted (\"{first}\" ...; nodes \
+                 marked in extras.streaklight): a new fit would add a second set beside them. \
+                 Fit the scene they were fitted into, or remove those nodes first",
+                plan.own_lights.len()
+            ),
+        ));
+    }
+    let (mut reads, mut writes) = (plan.reads, plan.writes);
+    reads.push(options.photo.clone());
     if let Some(report) = &options.report {
-        output_file::ensure_not_an_input(report, &inputs)?;
-        output_file::ensure_not_an_input(report, &[options.output.as_path()])?;
         // Checked now, so a missing or read-only report folder cannot leave a scene written
         // without its report.
-        output_file::ensure_folder_exists(report)?;
         output_file::ensure_writable(report)?;
+        writes.push(report.clone());
     }
-    Ok(())
+    if let Some(dir) = &options.debug_dir {
+        output_file::ensure_folder_writable(dir)?;
+        let all: Vec<&Path> = reads.iter().chain(&writes).map(PathBuf::as_path).collect();
+        if let Some(same) = all
+            .iter()
+            .find(|p| output_file::identity(p) == output_file::identity(dir))
+        {
+            return Err(Error::output(
+                dir,
+                format!(
+                    "the debug pictures' folder is the file {}; choose another folder",
+                    same.display()
+                ),
+            ));
+        }
+        writes.extend(debug_pictures::file_names().iter().map(|n| dir.join(n)));
+    }
+    let reads: Vec<&Path> = reads.iter().map(PathBuf::as_path).collect();
+    for w in &writes {
+        output_file::ensure_not_an_input(w, &reads)?;
+    }
+    output_file::ensure_distinct(&writes.iter().map(PathBuf::as_path).collect::<Vec<_>>())?;
+    Ok(writes)
 }
 
 /// A fitted light as a renderable area light (scene frame).
@@ -187,16 +229,22 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     })
 }
 
-/// Runs `run`; when it fails and [`ConvertOptions::report`] is set, writes there a report of
+/// Runs `run` in an [`output_file::Run`], so its outputs are written all together or not at
+/// all; when it fails and [`ConvertOptions::report`] is set, writes there (alone) a report of
 /// the refusal (the error's text and the files, [`report::Refusal`]) and returns the error.
 pub fn refusing<T>(options: &ConvertOptions, run: impl FnOnce() -> Result<T>) -> Result<T> {
-    let result = run();
-    if let (Err(e), Some(path)) = (&result, &options.report) {
-        let refusal = report::Refusal::new(
-            files(options, None),
-            reword(&e.to_string(), options.wording),
-        );
-        refusal.write(path)?;
+    let outputs = output_file::Run::begin();
+    let result = run().and_then(|value| outputs.commit().map(|_| value));
+    if let Err(e) = &result {
+        outputs.discard();
+        if let Some(path) = &options.report {
+            let refusal = report::Refusal::new(
+                files(options, None),
+                reword(&e.to_string(), options.wording),
+            );
+            refusal.write(path)?;
+            outputs.commit()?;
+        }
     }
     result
 }
@@ -225,6 +273,7 @@ pub fn convert_loaded(
     })?;
     check_photo(scene, &photo, &options.photo)?;
     let mut lit = pipeline::fit(scene, &photo, &options.fit, progress)?;
+    lit.warnings.extend(photo.warnings.iter().cloned());
     let word = |text: &str| reword(text, options.wording);
     if let Some((about, why)) = &lit.nothing_found {
         let message = format!(

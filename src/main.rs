@@ -55,6 +55,7 @@ pub enum Command {
 
 fn main() -> ExitCode {
     let parsed = Cli::parse();
+    streaklight::output_file::interrupt::install();
     let out = cli::output::Output::new(parsed.quiet, parsed.verbose);
     let exit = match parsed.command {
         Command::Fit(args) => cli::fit::run(args, &out),

@@ -29,6 +29,8 @@ pub struct Photo {
     pub display: Vec<[f32; 3]>,
     /// True when the file held floating-point (linear, unclipped) values.
     pub is_linear_float: bool,
+    /// What the user should know about the file's values (negative values read as 0).
+    pub warnings: Vec<String>,
 }
 
 /// The exact sRGB decoding curve (IEC 61966-2-1).
@@ -99,6 +101,7 @@ impl Photo {
             clipped,
             display,
             is_linear_float: false,
+            warnings: Vec::new(),
         }
     }
 
@@ -118,6 +121,7 @@ impl Photo {
             clipped,
             display,
             is_linear_float: true,
+            warnings: Vec::new(),
         }
     }
 }
@@ -134,7 +138,7 @@ pub const MAX_DECODE_BYTES: u64 = 2 << 30;
 /// Reads and decodes the photo at `path`; `exposure` divides the linear values (method §2).
 pub fn load(path: &Path, exposure: f32) -> Result<Photo> {
     check_exposure(exposure)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input_file::read(path)?;
     decode(&bytes, exposure, path)
 }
 
@@ -174,7 +178,7 @@ pub fn decode(bytes: &[u8], exposure: f32, path: &Path) -> Result<Photo> {
                 "the photo is too large ({e}); streaklight reads photos of at most {MAX_SIDE} pixels on a side and {} GiB of pixel data",
                 MAX_DECODE_BYTES >> 30
             ),
-            e => format!("cannot decode the photo: {e}"),
+            e => format!("cannot decode the photo: {}", in_words(&e)),
         };
         Error::photo(path, message)
     };
@@ -189,6 +193,11 @@ pub fn decode(bytes: &[u8], exposure: f32, path: &Path) -> Result<Photo> {
             ),
         ));
     }
+    crate::limits::check_memory(
+        pixels.saturating_mul(crate::limits::FIT_BYTES_PER_PIXEL),
+        &format!("the fit of this {width} x {height} photo"),
+    )
+    .map_err(|m| Error::photo(path, m))?;
     if decoder.total_bytes() > MAX_DECODE_BYTES {
         return Err(Error::photo(
             path,
@@ -200,7 +209,49 @@ pub fn decode(bytes: &[u8], exposure: f32, path: &Path) -> Result<Photo> {
         ));
     }
     let image = DynamicImage::from_decoder(decoder).map_err(cannot)?;
-    from_image(image, exposure).map_err(|message| Error::photo(path, message))
+    let mut photo = from_image(image, exposure).map_err(|message| Error::photo(path, message))?;
+    for w in &mut photo.warnings {
+        *w = format!("{}: {w}", path.display());
+    }
+    Ok(photo)
+}
+
+/// A decoder's error in words: the decoders' own texts can be dumps of their internal state
+/// (`CrcMismatch { .. }`, `Unknown(32)`).
+fn in_words(e: &image::ImageError) -> String {
+    use image::error::{ImageFormatHint, UnsupportedErrorKind};
+    use image::ImageError;
+    let format = |hint: &ImageFormatHint| match hint {
+        ImageFormatHint::Exact(f) => format!("{f:?}").to_uppercase(),
+        ImageFormatHint::Name(n) => n.to_uppercase(),
+        _ => "image".into(),
+    };
+    match e {
+        ImageError::Decoding(d) => format!(
+            "its {} data is damaged or cut short (a checksum, a length or a code in it is not \
+             what the format allows)",
+            format(&d.format_hint())
+        ),
+        ImageError::Unsupported(u) => match u.kind() {
+            UnsupportedErrorKind::Color(_) => format!(
+                "its {} pixel type is not one streaklight reads (8- or 16-bit integer grey or \
+                 RGB(A), or 32-bit float in OpenEXR and Radiance HDR): save it as one of those",
+                format(&u.format_hint())
+            ),
+            UnsupportedErrorKind::Format(hint) => format!(
+                "{} files are not read (PNG, JPEG, TIFF, OpenEXR, Radiance HDR are)",
+                format(&hint)
+            ),
+            _ => format!(
+                "it uses a feature of the {} format that streaklight does not read (for TIFF: \
+                 floating-point, planar or unusual sample formats; save it as 16-bit TIFF, PNG \
+                 or OpenEXR)",
+                format(&u.format_hint())
+            ),
+        },
+        ImageError::IoError(io) => format!("it cannot be read ({io})"),
+        _ => "its data is not a valid image".into(),
+    }
 }
 
 /// Converts a decoded image to a [`Photo`], choosing the decoding by the sample type.
@@ -216,12 +267,23 @@ pub fn from_image(image: DynamicImage, exposure: f32) -> std::result::Result<Pho
             if linear.iter().flatten().any(|c| !c.is_finite()) {
                 return Err("the photo holds NaN or infinite values".into());
             }
-            Ok(Photo::from_linear(
+            // Light is never negative: such values (a denoiser's or a subtraction's undershoot)
+            // are read as 0, and the user is told how many and how far below.
+            let negative = linear.iter().flatten().filter(|&&c| c < 0.0).count();
+            let lowest = linear.iter().flatten().copied().fold(0.0_f32, f32::min);
+            let mut photo = Photo::from_linear(
                 width,
                 height,
                 linear.into_iter().map(|p| p.map(|c| c.max(0.0))).collect(),
                 exposure,
-            ))
+            );
+            if negative > 0 {
+                photo.warnings.push(format!(
+                    "{negative} negative value(s) (the lowest {lowest}) were read as 0: light is \
+                     never negative"
+                ));
+            }
+            Ok(photo)
         }
         DynamicImage::ImageLuma16(_)
         | DynamicImage::ImageLumaA16(_)

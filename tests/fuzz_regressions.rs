@@ -272,7 +272,10 @@ fn buffer_files_are_only_read_from_a_folder_and_only_regular_files() {
         .err()
         .unwrap()
         .to_string();
-    assert!(e.contains("not a regular file"), "{e}");
+    assert!(
+        e.contains("is a device; streaklight reads only regular files"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -220,9 +220,17 @@ fn fit_all(args: &Args, out: &Output, summary: &mut Summary) -> streaklight::Res
             glb: args.glb,
         },
     )?;
-    if let Some(dir) = &args.out_dir {
-        std::fs::create_dir_all(dir).map_err(|e| streaklight::Error::io(dir, e))?;
-    }
+    super::caps::fit(args)?;
+    // Made for this run, the folder is removed again if no photo wrote into it.
+    let made_out_dir = match &args.out_dir {
+        Some(dir) => {
+            streaklight::output_file::ensure_folder_writable(dir)?;
+            let made = !dir.exists();
+            streaklight::output_file::create_dir_all(dir)?;
+            made.then_some(dir)
+        }
+        None => None,
+    };
     let template = ConvertOptions {
         fit: args.fit_settings()?,
         load: args.scene_options.load_options(match args.gloss {
@@ -239,7 +247,11 @@ fn fit_all(args: &Args, out: &Output, summary: &mut Summary) -> streaklight::Res
         wording: super::flags::flag,
         ..ConvertOptions::new(&args.scene, "", "")
     };
-    let results = convert_all(&template, &jobs)?;
+    let results = convert_all(&template, &jobs);
+    if let Some(dir) = made_out_dir {
+        let _ = std::fs::remove_dir(dir);
+    }
+    let results = results?;
     for (job, result) in jobs.iter().zip(results) {
         let photo = job.photo.display().to_string();
         match result {

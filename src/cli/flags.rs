@@ -26,5 +26,5 @@ pub fn flag(setting: Setting) -> String {
 
 /// A library message with its settings spelled as flags.
 pub fn in_flags(text: &str) -> String {
-    reword(text, flag)
+    streaklight::names::for_terminal(&reword(text, flag))
 }

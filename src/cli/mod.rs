@@ -1,5 +1,6 @@
 //! One file per subcommand: its arguments and a `run` that calls the library.
 
+pub mod caps;
 pub mod completions;
 pub mod exit;
 pub mod fit;

@@ -49,6 +49,7 @@ impl Terminal {
 
     /// Prints `line` on stderr, above the bar if one is shown.
     pub fn println(&self, line: &str) {
+        let line = streaklight::names::for_terminal(line);
         let current = self.current.lock().unwrap_or_else(|e| e.into_inner());
         match current.as_ref().and_then(|c| c.bar.as_ref()) {
             Some(bar) => bar.suspend(|| eprintln!("{line}")),
@@ -99,7 +100,7 @@ impl Progress for Terminal {
             return;
         }
         self.finish();
-        eprintln!("{line}");
+        eprintln!("{}", streaklight::names::for_terminal(line));
         let bar = self.terminal.then(|| Self::spinner(line));
         let mut current = self.current.lock().unwrap_or_else(|e| e.into_inner());
         *current = Some(Current {

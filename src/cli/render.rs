@@ -58,10 +58,12 @@ pub struct Args {
 /// Runs the command.
 pub fn run(args: Args, out: &Output) -> streaklight::Result<()> {
     photo_out::ImageFormat::from_path(&args.output)?;
+    super::caps::render(args.width, args.height.unwrap_or(1), args.spp)?;
     output_file::ensure_not_an_input(&args.output, &[&args.scene])?;
     // Before the render, not after it: a folder that cannot take the image fails at once.
-    output_file::ensure_folder_exists(&args.output)?;
     output_file::ensure_writable(&args.output)?;
+    // The scene's buffers are recorded as they are read: the image is never written over one.
+    let run = output_file::Run::begin();
     let scene = scene_in::load(&args.scene, &args.scene_options.load_options(args.gloss))?;
     for w in &scene.warnings {
         out.warn(w);
@@ -76,6 +78,7 @@ pub fn run(args: Args, out: &Output) -> streaklight::Result<()> {
         let aspect = scene.camera.aspect_ratio.unwrap_or(1.0);
         ((args.width as f32 / aspect).round() as u32).max(1)
     });
+    super::caps::render(args.width, height, args.spp)?;
     out.progress().stage("rendering");
     let options = RenderOptions {
         width: args.width,
@@ -89,6 +92,7 @@ pub fn run(args: Args, out: &Output) -> streaklight::Result<()> {
     };
     let image = render(&scene, &options)?;
     photo_out::write(&args.output, image.width, image.height, &image.pixels)?;
+    run.commit()?;
     out.info(&format!(
         "wrote {} ({} x {}, {} spp) in {:.2} s: {:.2} M reflected rays/s",
         args.output.display(),

@@ -31,7 +31,9 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args, out: &Output) -> streaklight::Result<()> {
+    let run = streaklight::output_file::Run::begin();
     let summary = restore_lights(&args.input, &args.output, args.files.input_files())?;
+    run.commit()?;
     for w in &summary.resources.warnings {
         out.warn(w);
     }

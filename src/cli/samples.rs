@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use streaklight::samples;
+use streaklight::{output_file, samples};
 
 /// `samples --help`'s epilogue.
 pub const AFTER_HELP: &str = concat!(
@@ -32,12 +32,27 @@ pub struct Args {
 }
 
 /// Runs the command.
+/// The scenes are written together, then the photos rendered from them together
+/// ([`output_file::Run`]): an interrupted or failed run leaves no temporary file and no
+/// half-written set.
 pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
-    for path in samples::write_scenes(&args.dir)? {
+    streaklight::limits::check_cap(
+        "--spp",
+        args.spp.into(),
+        super::caps::SPP,
+        "camera rays per pixel",
+    )?;
+    output_file::ensure_folder_writable(&args.dir)?;
+    let run = output_file::Run::begin();
+    let scenes = samples::write_scenes(&args.dir)?;
+    run.commit()?;
+    for path in scenes {
         out.info(&format!("wrote {}", path.display()));
     }
     if !args.scenes_only {
-        for path in samples::render_photos(&args.dir, args.spp, &args.photos, out.progress())? {
+        let photos = samples::render_photos(&args.dir, args.spp, &args.photos, out.progress())?;
+        run.commit()?;
+        for path in photos {
             out.info(&format!("wrote {}", path.display()));
         }
     }

@@ -7,7 +7,7 @@ use streaklight::streaks::{self, pictures, report};
 
 use super::streak_args::StreakArgs;
 use super::values::ExposureArg;
-use streaklight::{photo_exif, photo_in, water_mask, Error};
+use streaklight::{output_file, photo_exif, photo_in, water_mask, Error};
 
 /// Arguments of `streaklight segment`.
 #[derive(clap::Args)]
@@ -36,10 +36,18 @@ pub struct Args {
     pub streak: StreakArgs,
 }
 
-/// Runs the command.
+/// Runs the command. Nothing is written unless streaks are found; the pictures and
+/// streaks.json are then written together ([`output_file::Run`]).
 pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
     let params = args.streak.params()?;
-
+    output_file::ensure_folder_writable(&args.out_dir)?;
+    let mut names: Vec<&str> = pictures::PICTURE_NAMES.to_vec();
+    names.push(pictures::STREAKS_JSON);
+    let outputs: Vec<PathBuf> = names.iter().map(|n| args.out_dir.join(n)).collect();
+    for o in &outputs {
+        output_file::ensure_not_an_input(o, &[&args.scene, &args.photo])?;
+    }
+    let run = output_file::Run::begin();
     let exposure = match args.exposure {
         ExposureArg::Value(e) => e,
         ExposureArg::Auto => {
@@ -62,16 +70,21 @@ pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
     }
     streaklight::convert::check_photo(&scene, &photo, &args.photo)?;
     let water = water_mask::water_mask(&scene, photo.width, photo.height);
-    let seg = streaks::extract_streaks(&photo, &water, &params).map_err(|e| match e {
+    let in_photo = |e: Error| match e {
         Error::NothingFound(m) => Error::NothingFound(format!("{}: {m}", args.photo.display())),
         other => other,
-    })?;
+    };
+    let seg = streaks::extract_streaks(&photo, &water, &params).map_err(in_photo)?;
+    seg.require_streaks()
+        .map_err(|e| Error::NothingFound(format!("{}: {e}", args.photo.display())))?;
 
-    std::fs::create_dir_all(&args.out_dir).map_err(|e| Error::io(&args.out_dir, e))?;
-    let written = pictures::write_pictures(&args.out_dir, &photo, &water, &seg)?;
-    let json = args.out_dir.join("streaks.json");
+    output_file::create_dir_all(&args.out_dir)?;
+    let mut written = pictures::write_pictures(&args.out_dir, &photo, &water, &seg)?;
+    let json = args.out_dir.join(pictures::STREAKS_JSON);
     report::write_report(&json, &seg, &params)?;
-    for p in written.iter().chain(std::iter::once(&json)) {
+    written.push(json);
+    run.commit()?;
+    for p in &written {
         println!("wrote {}", p.display());
     }
     for s in &seg.streaks {
@@ -87,6 +100,5 @@ pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
             s.brightest.1
         );
     }
-    seg.require_streaks()
-        .map_err(|e| Error::NothingFound(format!("{}: {e}", args.photo.display())))
+    Ok(())
 }

@@ -29,7 +29,7 @@ use crate::report::Report;
 use crate::scene_in::{AreaLight, Scene};
 use crate::streaks::pictures::write_png;
 use crate::water_model::{water_statistics, StatisticalSurface, WaterModel};
-use crate::{streaks, Error, Result};
+use crate::{streaks, Result};
 use canvas::{label, outline, side_by_side, with_header, Key};
 use html::Figure;
 
@@ -68,7 +68,7 @@ pub fn write(
     report: &Report,
     options: &ConvertOptions,
 ) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    crate::output_file::create_dir_all(dir)?;
     let mut figures = Vec::new();
     let mut written = Vec::new();
     let captions = [
@@ -89,7 +89,7 @@ pub fn write(
             caption: caption.into(),
         });
     }
-    let json = dir.join("streaks.json");
+    let json = dir.join(streaks::pictures::STREAKS_JSON);
     streaks::report::write_report(&json, &lit.segmentation, &options.fit.streaks)?;
     written.push(json);
 
@@ -105,7 +105,7 @@ pub fn write(
             .into(),
     });
 
-    let index = dir.join("index.html");
+    let index = dir.join(INDEX);
     write_atomically(&index, html::page(report, &figures).as_bytes())?;
     written.push(index);
     Ok(written)
@@ -113,6 +113,15 @@ pub fn write(
 
 /// The file name of the photo / model / residual picture.
 pub const FIT_PICTURE: &str = "fit-photo-render-difference.png";
+/// The file name of the page showing the pictures.
+pub const INDEX: &str = "index.html";
+
+/// Every file [`write`] writes into its folder.
+pub fn file_names() -> Vec<&'static str> {
+    let mut names = streaks::pictures::PICTURE_NAMES.to_vec();
+    names.extend([streaks::pictures::STREAKS_JSON, FIT_PICTURE, INDEX]);
+    names
+}
 
 fn render_lights(
     scene: &Scene,

@@ -459,7 +459,7 @@ fn scene_parts<'a>(spec: &'a SampleScene, buffers: &'a WaterBuffers) -> ScenePar
 
 /// Writes the water meshes and every sample scene into `dir`; returns the files written.
 pub fn write_scenes(dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    crate::output_file::create_dir_all(dir)?;
     let buffers = WaterBuffers::new();
     let mut written = Vec::new();
     for (file, buffer) in buffers.files() {

@@ -122,7 +122,7 @@ pub fn percent_decode(uri: &str) -> String {
 
 /// Reads the scene file at `path`.
 pub fn read(path: &Path) -> Result<SourceDocument> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input_file::read(path)?;
     from_bytes(&bytes, path, Some(path.parent().unwrap_or(Path::new("."))))
 }
 
@@ -237,14 +237,10 @@ fn check_position_accessors(json: &Value) -> std::result::Result<(), String> {
     Ok(())
 }
 
-/// Reads an external buffer. Only regular files: a URI naming a device such as `/dev/zero`
-/// would otherwise be read without end.
+/// Reads an external buffer, bounded ([`crate::input_file::read`]: a URI naming a device such
+/// as `/dev/zero` would otherwise be read without end).
 fn read_buffer_file(file: &Path) -> std::result::Result<Vec<u8>, String> {
-    let what = |e: std::io::Error| format!("({}): {e}", file.display());
-    if !std::fs::metadata(file).map_err(what)?.is_file() {
-        return Err(format!("({}): not a regular file", file.display()));
-    }
-    std::fs::read(file).map_err(what)
+    crate::input_file::read(file).map_err(|e| format!("({e})"))
 }
 
 fn describe_validation(e: &gltf::Error) -> String {

@@ -103,14 +103,42 @@ fn check_options(options: &LoadOptions) -> Result<()> {
             format!("must be a positive number, not {}", options.nits_scale),
         ));
     }
+    if options.nits_scale > MAX_NITS_SCALE {
+        return Err(Error::setting(
+            Setting::NitsScale,
+            format!(
+                "must be at most {MAX_NITS_SCALE:e} (683 turns W/(sr m^2) into nits), not {}: \
+                 the lights' intensities would overflow",
+                short(options.nits_scale)
+            ),
+        ));
+    }
     Ok(())
+}
+
+/// Largest nits scale accepted: a light's intensity (its radiance times the scale) must stay a
+/// finite number, and no unit conversion is anywhere near this.
+pub const MAX_NITS_SCALE: f64 = 1e9;
+
+/// Farthest a camera may be from the scene's origin along any axis, in scene units: the
+/// geometry is traced relative to the camera in single precision, and beyond this it would
+/// overflow or lose every detail (georeferenced scenes are well within it).
+pub const MAX_CAMERA_DISTANCE: f64 = 1e9;
+
+/// A coordinate for a message: in exponent form when large (1e308 has 309 digits).
+fn short(v: f64) -> String {
+    if v.abs() < 1e6 {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }
 
 /// Loads the scene at `path` (`.gltf` or `.glb`).
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
     // A bad option is reported before a missing file.
     check_options(options)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input_file::read(path)?;
     load_from_bytes(
         &bytes,
         Some(path.parent().unwrap_or(Path::new("."))),
@@ -138,8 +166,22 @@ pub fn load_from_bytes(
     let camera = choose_camera(doc, &instances, options.camera.as_deref()).map_err(err)?;
     let (cam_node, cam_world, yfov, aspect) = camera;
     let origin = cam_world.w_axis.truncate();
-    if !origin.is_finite() {
-        return Err(Error::scene(path, "the camera's position is not finite"));
+    if !(origin.is_finite() && origin.abs().max_element() <= MAX_CAMERA_DISTANCE) {
+        let name = doc
+            .nodes()
+            .nth(cam_node)
+            .and_then(|n| n.name().map(crate::names::escaped))
+            .unwrap_or_else(|| format!("node {cam_node}"));
+        return Err(Error::scene(
+            path,
+            format!(
+                "the camera \"{name}\" is at ({}, {}, {}): a camera must be within \
+                 {MAX_CAMERA_DISTANCE:e} of the scene's origin (and finite)",
+                short(origin.x),
+                short(origin.y),
+                short(origin.z)
+            ),
+        ));
     }
     let node_names: Vec<Option<String>> =
         doc.nodes().map(|n| n.name().map(str::to_owned)).collect();
@@ -164,7 +206,8 @@ pub fn load_from_bytes(
     let mut warnings = Vec::new();
     let water_node =
         water::choose(doc, &source.json, &instances, options.water.as_deref()).map_err(err)?;
-    let water = water::optics(doc, water_node, options.gloss, options.ior, &mut warnings);
+    let water =
+        water::optics(doc, water_node, options.gloss, options.ior, &mut warnings).map_err(err)?;
 
     let tris =
         meshes::collect(doc, &source.json, &source.buffers, &instances, origin).map_err(err)?;

@@ -50,8 +50,8 @@ fn display_name(doc: &gltf::Document, node: usize) -> String {
         return format!("node {node}");
     };
     n.name()
-        .map(str::to_owned)
-        .or_else(|| n.mesh().and_then(|m| m.name().map(str::to_owned)))
+        .map(crate::names::escaped)
+        .or_else(|| n.mesh().and_then(|m| m.name().map(crate::names::escaped)))
         .unwrap_or_else(|| format!("node {node}"))
 }
 
@@ -127,14 +127,19 @@ pub fn choose(
     }
 }
 
-/// Reads the water's gloss and IOR from its material, with the user's overrides.
+/// The indices of refraction accepted: light reflects off a surface only above 1, and no
+/// liquid (nor most solids) reaches 3; outside this, a material's value is a mistake.
+pub const IOR_RANGE: (f32, f32) = (1.0, 3.0);
+
+/// Reads the water's gloss and IOR from its material, with the user's overrides. An IOR
+/// outside [`IOR_RANGE`] (1 excluded) is refused, naming where it came from.
 pub fn optics(
     doc: &gltf::Document,
     node: usize,
     gloss_override: Option<f32>,
     ior_override: Option<f32>,
     warnings: &mut Vec<String>,
-) -> Water {
+) -> std::result::Result<Water, String> {
     let name = display_name(doc, node);
     let material = doc
         .nodes()
@@ -160,13 +165,32 @@ pub fn optics(
     let ior = ior_override
         .or_else(|| material.as_ref().and_then(|m| m.ior()))
         .unwrap_or(WATER_IOR);
-    Water {
+    if !(ior > IOR_RANGE.0 && ior <= IOR_RANGE.1) {
+        let source = match (ior_override, &material) {
+            (Some(_), _) => Setting::Ior.to_string(),
+            (None, Some(m)) => format!(
+                "the water's material \"{}\" (KHR_materials_ior)",
+                m.name()
+                    .map(crate::names::escaped)
+                    .unwrap_or_else(|| format!("{}", m.index().unwrap_or(0)))
+            ),
+            (None, None) => "the default".into(),
+        };
+        return Err(format!(
+            "the index of refraction {ior} of {source} is outside {} < IOR <= {} (water: \
+             {WATER_IOR}); light would not reflect as it does off water ({} overrides it)",
+            IOR_RANGE.0,
+            IOR_RANGE.1,
+            Setting::Ior
+        ));
+    }
+    Ok(Water {
         node,
         name,
         gloss,
         ior,
         gloss_source,
-    }
+    })
 }
 
 #[cfg(test)]

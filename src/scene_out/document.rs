@@ -66,7 +66,7 @@ pub struct Document {
 
 /// Reads and checks the glTF file at `path`. Every error names the file.
 pub fn read(path: &Path) -> Result<Document> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input_file::read(path)?;
     let says_glb = path
         .extension()
         .and_then(|e| e.to_str())

@@ -198,9 +198,9 @@ pub(crate) fn uri_bytes(
         return Ok(None);
     };
     let path = input_dir.join(relative);
-    std::fs::read(&path)
+    crate::input_file::read(&path)
         .map(Some)
-        .map_err(|e| Error::scene(input, format!("{what}'s file {}: {e}", path.display())))
+        .map_err(|e| Error::scene(input, format!("{what}'s file {e}")))
 }
 
 /// Points every buffer view at the output buffer holding its input buffer's bytes

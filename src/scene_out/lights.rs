@@ -72,6 +72,13 @@ pub(crate) fn prepare(
         )));
     }
     let max = light.radiance.iter().copied().fold(0.0_f64, f64::max);
+    if !(max * nits_scale).is_finite() {
+        return Err(bad(format!(
+            "its intensity, radiance {max} times the nits scale {nits_scale}, is too large for \
+             a number (a glTF file would hold null); use a nits scale of at most {}",
+            crate::scene_in::MAX_NITS_SCALE
+        )));
+    }
     let color = if max > 0.0 {
         light.radiance.map(|c| c / max)
     } else {

@@ -34,6 +34,24 @@ use edit::{array_mut, len_of, object_mut, push, root_mut, use_extension};
 pub use lights::EXTENSION;
 pub use restore::{restore_lights, RestoreSummary};
 
+/// What writing the scene `input` as `output` involves, known before any work.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Plan {
+    /// The files it reads: the input and the local buffer and image files it refers to.
+    pub reads: Vec<PathBuf>,
+    /// The files it may write: the output and the files beside it.
+    pub writes: Vec<PathBuf>,
+    /// The names of the lights a run of streaklight already wrote into the input (nodes
+    /// marked `extras.streaklight.role = "light"`).
+    pub own_lights: Vec<String>,
+}
+
+/// Reads `input` and tells what writing it as `output` involves: the caller checks the files
+/// against its own inputs and outputs before any work.
+pub fn plan(input: &Path, output: &Path, files: InputFiles) -> Result<Plan> {
+    staged::plan(input, output, files)
+}
+
 /// One fitted light, in world space, as the fitter hands it over.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightToWrite {

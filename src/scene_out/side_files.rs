@@ -19,7 +19,7 @@ use serde_json::Value;
 
 use super::resources::{encode_path, LocalResource};
 use super::ResourceKind;
-use crate::{Error, Result};
+use crate::Result;
 
 /// A file written beside the output: where, and its bytes.
 pub(crate) type SideFile = (PathBuf, Vec<u8>);
@@ -67,7 +67,7 @@ pub(crate) fn copy_beside(
             Some(name) => name.clone(),
             None => {
                 let name = copy_name(stem, res.kind, res.index, &res.path);
-                let bytes = std::fs::read(&res.path).map_err(|e| Error::io(&res.path, e))?;
+                let bytes = crate::input_file::read(&res.path)?;
                 files.push((folder.join(&name), bytes));
                 names.insert(&res.path, name.clone());
                 name

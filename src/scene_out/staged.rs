@@ -18,7 +18,7 @@ use super::document::{self, padded_len, Document, Format};
 use super::edit::{len_of, push, root_mut};
 use super::side_files::{self, SideFile};
 use super::{embed, resources, InputFiles, NewData, ResourceHandling};
-use crate::output_file::{ensure_not_an_input, write_atomically};
+use crate::output_file::{self, ensure_not_an_input};
 use crate::{Error, Result};
 
 /// See the module docs.
@@ -196,9 +196,9 @@ impl Staged {
         Ok((buffer, offset))
     }
 
-    /// Writes the files beside the output, then the output, each atomically; checks first that
-    /// none of them is an input. If a write fails, the files already written are removed (or
-    /// their previous content put back).
+    /// Writes the files beside the output, then the output, all together
+    /// ([`output_file::Run`]: the output is renamed into place last); checks first that none of
+    /// them is an input or another. If a write fails, nothing is left written.
     pub fn write(mut self, output: &Path) -> Result<ResourceHandling> {
         let mut files = std::mem::take(&mut self.side);
         if let Some(bin) = self.moved_bin0.take() {
@@ -218,19 +218,19 @@ impl Staged {
         for (path, _) in &files {
             ensure_not_an_input(path, &inputs)?;
         }
-        let mut written: Vec<(PathBuf, Option<Vec<u8>>)> = Vec::new();
-        for (path, bytes) in &files {
-            let previous = std::fs::read(path).ok();
-            if let Err(e) = write_atomically(path, bytes) {
-                for (done, old) in written.iter().rev() {
-                    let _ = match old {
-                        Some(old) => write_atomically(done, old),
-                        None => std::fs::remove_file(done).map_err(|e| Error::io(done, e)),
-                    };
-                }
-                return Err(e);
+        output_file::ensure_distinct(&files.iter().map(|(p, _)| p.as_path()).collect::<Vec<_>>())?;
+        // All together or nothing: in the caller's run if it opened one, else in our own.
+        let run = output_file::Run::begin();
+        let count = files.len();
+        for (k, (path, bytes)) in files.iter().enumerate() {
+            if k + 1 == count {
+                output_file::write_atomically_last(path, bytes)?;
+            } else {
+                output_file::write_atomically(path, bytes)?;
             }
-            written.push((path.clone(), previous));
+        }
+        if run.owns() {
+            run.commit()?;
         }
         self.handling.files_written = files.into_iter().map(|(p, _)| p).collect();
         Ok(self.handling)
@@ -284,4 +284,48 @@ pub(crate) fn bin_chunk_buffer(doc: &Document, input: &Path) -> Result<Option<Ve
         )
     })?;
     Ok(Some(bytes.to_vec()))
+}
+
+/// What writing `input` as `output` involves, known before any work (see [`super::Plan`]).
+pub(crate) fn plan(input: &Path, output: &Path, files: InputFiles) -> Result<super::Plan> {
+    let doc = document::read(input)?;
+    let own_lights = doc
+        .json
+        .get("nodes")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .filter(|n| n.pointer("/extras/streaklight/role") == Some(&json!("light")))
+        .map(|n| {
+            n.get("name")
+                .and_then(Value::as_str)
+                .map_or_else(|| "unnamed".into(), crate::names::escaped)
+        })
+        .collect();
+    let input_dir = folder_of(input)
+        .canonicalize()
+        .map_err(|e| Error::io(input, e))?;
+    let local = resources::local_resources(&doc.json, &input_dir);
+    let mut reads = vec![input.to_path_buf()];
+    reads.extend(local.iter().map(|r| r.path.clone()));
+    let mut writes = vec![output.to_path_buf()];
+    if Format::from_output_path(output)? == Format::Gltf {
+        let folder = folder_of(output);
+        let stem = output.file_stem().and_then(|n| n.to_str()).unwrap_or("");
+        writes.push(folder.join(side_files::data_name(stem)));
+        if files == InputFiles::Copy {
+            let mut seen = std::collections::HashSet::new();
+            for r in &local {
+                if seen.insert(r.path.clone()) {
+                    let name = side_files::copy_name(stem, r.kind, r.index, &r.path);
+                    writes.push(folder.join(name));
+                }
+            }
+        }
+    }
+    Ok(super::Plan {
+        reads,
+        writes,
+        own_lights,
+    })
 }

@@ -202,7 +202,7 @@ pub fn pictures(
     streak_keys.push(Key::new([255, 255, 255], "+ brightest pixel"));
     vec![
         (
-            "superpixels.png",
+            PICTURE_NAMES[0],
             with_header(
                 &superpixels_picture(photo, seg),
                 &format!(
@@ -213,7 +213,7 @@ pub fn pictures(
             ),
         ),
         (
-            "seeds.png",
+            PICTURE_NAMES[1],
             with_header(
                 &seeds_picture(photo, seg),
                 &format!(
@@ -230,7 +230,7 @@ pub fn pictures(
             ),
         ),
         (
-            "streaks.png",
+            PICTURE_NAMES[2],
             with_header(
                 &streaks,
                 &format!(
@@ -241,7 +241,7 @@ pub fn pictures(
             ),
         ),
         (
-            "edges.png",
+            PICTURE_NAMES[3],
             with_header(
                 &edges,
                 "Streak edges by side (the pixels that place the lights' edges)",
@@ -255,6 +255,12 @@ pub fn pictures(
         ),
     ]
 }
+
+/// The file names of the pictures [`write_pictures`] writes, in order.
+pub const PICTURE_NAMES: [&str; 4] = ["superpixels.png", "seeds.png", "streaks.png", "edges.png"];
+
+/// The file name of the streaks' JSON report (`segment`, `--debug-dir`).
+pub const STREAKS_JSON: &str = "streaks.json";
 
 /// Writes the four pictures into `dir` and returns their paths.
 pub fn write_pictures(
