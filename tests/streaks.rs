@@ -344,7 +344,7 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
     broken["streaks"][0].as_object_mut().unwrap().remove("bbox");
     assert!(!validator.is_valid(&broken));
 
-    // No lights: the pictures and report are still written, and the command fails clearly.
+    // No lights: the command fails clearly and writes nothing (a refused run leaves no file).
     let dark = sample_photo_path("dark.png");
     let out_dark = common::temp_dir("segment-cli-dark");
     let (ok, _, stderr) = common::run_cli(&[
@@ -359,7 +359,10 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
         stderr.contains("dark.png") && stderr.contains("no streak found"),
         "{stderr}"
     );
-    assert!(out_dark.join("streaks.json").is_file());
+    assert!(
+        !out_dark.join("streaks.json").exists(),
+        "a run that found no streak wrote its report"
+    );
 
     // A bad setting is refused as it is parsed, naming the option and its range.
     let (ok, _, stderr) = common::run_cli(&[
