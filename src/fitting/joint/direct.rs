@@ -332,4 +332,4 @@ impl Problem {
 }
 
 #[cfg(test)]
-mod tests;
+pub(super) mod tests;

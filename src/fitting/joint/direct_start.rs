@@ -264,33 +264,11 @@ mod tests {
     use super::*;
     use crate::fitting::light_plane::LightPlane;
     use crate::fitting::EdgeStatus;
-    use glam::Vec3;
 
     /// Table 1's scene and photo (one 3 m x 3 m light on the wall, in frame), the wall as a
     /// light plane, and the light's true rectangle on it (from the sample's definition).
     fn table1() -> (Scene, Photo, Vec<bool>, LightPlane, Rect) {
-        let (scene, photo, water, _) = crate::samples::fixture("table1.png");
-        let origin = scene.camera.position;
-        let dir = scene
-            .camera
-            .direction(300.5, 100.5, photo.width, photo.height);
-        let hit = scene
-            .tracer
-            .closest_hit(origin, dir, 0.0, f32::INFINITY)
-            .expect("the wall");
-        let s = scene.sources[hit.triangle as usize];
-        let mut normal = scene.face_normal(hit.triangle);
-        if normal.dot(dir) > 0.0 {
-            normal = -normal;
-        }
-        let plane = LightPlane::with_frame(
-            (s.node as usize, s.mesh as usize, s.primitive as usize),
-            origin + dir * hit.t,
-            normal,
-            Vec3::X,
-            1.0,
-        )
-        .expect("a plane");
+        let (scene, photo, water, plane) = crate::fitting::joint::direct::tests::table1_wall();
         let truth = crate::samples::table1_light();
         let at = |x: f64, y: f64| {
             plane.coords((glam::DVec3::new(x, y, truth.corner.z) - scene.origin).as_vec3())

@@ -2,11 +2,18 @@ use glam::{Vec2, Vec3};
 
 use super::*;
 use crate::fitting::joint::kernel::kernel_coverage;
+use crate::photo_in::Photo;
 use crate::samples::PHOTO_SIZE;
 
 /// The samples' scene (camera at (0, 0.2, 10) looking down -z, the wall at z = 0 facing it),
 /// its water mask, and the wall as a light plane, found by the camera ray through `pixel`.
 fn wall() -> (Scene, Vec<bool>, LightPlane) {
+    let (scene, _, water, plane) = table1_wall();
+    (scene, water, plane)
+}
+
+/// [`wall`] with Table 1's photo (one 3 m x 3 m light on that wall, in frame).
+pub(in crate::fitting::joint) fn table1_wall() -> (Scene, Photo, Vec<bool>, LightPlane) {
     let (scene, photo, water, _) = crate::samples::fixture("table1.png");
     assert_eq!((photo.width, photo.height), (PHOTO_SIZE, PHOTO_SIZE));
     let origin = scene.camera.position;
@@ -28,7 +35,7 @@ fn wall() -> (Scene, Vec<bool>, LightPlane) {
         1.0,
     )
     .expect("a plane");
-    (scene, water, plane)
+    (scene, photo, water, plane)
 }
 
 /// Where the corner (`x`, `y`) of the image lands on the plane.
