@@ -69,6 +69,22 @@ pub struct Quad {
     pub normal: [f32; 3],
 }
 
+impl Quad {
+    /// Level water at y = 0 from z = `near` to z = `far` (the camera looks down -z), `half`
+    /// to either side of x = 0, facing up.
+    pub fn level_water(near: f32, far: f32, half: f32) -> Quad {
+        Quad {
+            corners: [
+                [-half, 0.0, near],
+                [half, 0.0, near],
+                [half, 0.0, far],
+                [-half, 0.0, far],
+            ],
+            normal: [0.0, 1.0, 0.0],
+        }
+    }
+}
+
 /// A named mesh of quads, written as one data-URI buffer.
 #[derive(Clone, Debug)]
 pub struct Solid {

@@ -177,20 +177,11 @@ pub fn water_mesh(realisation: usize) -> WaterMesh {
 
 /// The flat water: one quad over the grid's extent.
 pub fn flat_water() -> Quad {
-    let (near, far) = (
+    Quad::level_water(
         (HARBOUR_CAMERA[2] - QUAY_EDGE) as f32,
         (HARBOUR_CAMERA[2] - WATER_FAR) as f32,
-    );
-    let w = half_width(WATER_FAR) as f32;
-    Quad {
-        corners: [
-            [-w, 0.0, near],
-            [w, 0.0, near],
-            [w, 0.0, far],
-            [-w, 0.0, far],
-        ],
-        normal: [0.0, 1.0, 0.0],
-    }
+        half_width(WATER_FAR) as f32,
+    )
 }
 
 /// The facade at z = 0 (facing the camera) and the near quay (its top and its face towards

@@ -373,20 +373,11 @@ fn paper_wall(z: f64) -> Solid {
 /// The flat water of the paper's setup: one quad over the water grid's extent.
 fn paper_flat_water() -> Quad {
     let grid = water_grid();
-    let (near, far) = (
+    Quad::level_water(
         (grid.eye_z - grid.near) as f32,
         (grid.eye_z - grid.far) as f32,
-    );
-    let w = (grid.half_width_per_distance * grid.far) as f32;
-    Quad {
-        corners: [
-            [-w, 0.0, near],
-            [w, 0.0, near],
-            [w, 0.0, far],
-            [-w, 0.0, far],
-        ],
-        normal: [0.0, 1.0, 0.0],
-    }
+        (grid.half_width_per_distance * grid.far) as f32,
+    )
 }
 
 /// The generated water meshes, by setup and realisation.
