@@ -24,7 +24,7 @@ impl WaterBuffer {
     /// The buffer of `mesh`.
     pub fn new(mesh: &WaterMesh) -> Self {
         let mut bytes = Vec::with_capacity(mesh.positions.len() * 24 + mesh.indices.len() * 4);
-        let (min, max) = bounds(&mesh.positions);
+        let (min, max) = vec3_bounds(&mesh.positions);
         for p in &mesh.positions {
             for c in p {
                 bytes.extend_from_slice(&c.to_le_bytes());
@@ -48,7 +48,8 @@ impl WaterBuffer {
     }
 }
 
-fn bounds(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+/// The per-component minimum and maximum of `points`, as a POSITION accessor's `min`, `max`.
+pub fn vec3_bounds(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
     for p in points {
@@ -207,7 +208,14 @@ impl Buffers {
         }
         let buffer = json!({"uri": data_uri(&bytes), "byteLength": bytes.len()});
         let n = quads.len();
-        self.primitive(buffer, 4 * n, 6 * n, 5123, bounds(&positions), material)
+        self.primitive(
+            buffer,
+            4 * n,
+            6 * n,
+            5123,
+            vec3_bounds(&positions),
+            material,
+        )
     }
 }
 

@@ -52,17 +52,7 @@ pub fn u32_bytes(values: &[u32]) -> Vec<u8> {
 }
 
 /// The per-component minimum and maximum of `points`, as a POSITION accessor's `min`, `max`.
-pub fn vec3_bounds(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
-    let mut min = [f32::INFINITY; 3];
-    let mut max = [f32::NEG_INFINITY; 3];
-    for p in points {
-        for c in 0..3 {
-            min[c] = min[c].min(p[c]);
-            max[c] = max[c].max(p[c]);
-        }
-    }
-    (min, max)
-}
+pub use streaklight::samples::gltf_doc::vec3_bounds;
 
 /// Pads `bin` with zeros to a multiple of 4, appends `bytes` and returns their offset.
 pub fn append_aligned(bin: &mut Vec<u8>, bytes: &[u8]) -> usize {
