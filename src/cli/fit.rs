@@ -105,9 +105,10 @@ pub struct Args {
     /// photo's very waves, as when the photo was rendered from the scene), "statistical" (the
     /// scene gives the mean water surface, a flat quad or another field of waves, and the
     /// waves' slopes are estimated from the photo, along and across the view), or "auto"
-    /// (exact if its fine structure matches the photo's, else statistical; the report says
-    /// which, and why; not yet reliable on every scene, so not the default).
-    #[arg(long, default_value = "exact", value_parser = ["auto", "exact", "statistical"])]
+    /// (the default: statistical when the scene's water is flat; else a first exact fit, kept
+    /// if the photo's fine glints match the ones the scene's waves put there, and the fit
+    /// made again with the statistical model if not; the report says which model, and why).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "exact", "statistical"])]
     pub water_model: String,
     /// Run the joint fit this many times, each from its own samples, and report the mean: N
     /// times slower, about sqrt(N) times less of the samples' noise; the uncertainties add the

@@ -20,7 +20,7 @@ pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
 pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
 pub use water_choice::{
     fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_CORRELATION,
-    EXACT_MIN_EXPLAINED,
+    EXACT_MIN_EXPLAINED, FLAT_SHARE,
 };
 
 use crate::fitting::gloss::estimate_gloss;
@@ -190,10 +190,15 @@ pub fn fit(
         modelled: Vec::new(),
     };
     let water_model = if observations.is_empty() {
-        WaterModelUsed::forced(match settings.water {
-            WaterChoice::Statistical => "statistical",
-            WaterChoice::Exact | WaterChoice::Auto => "exact",
-        })
+        match settings.water {
+            WaterChoice::Statistical => WaterModelUsed::forced("statistical"),
+            WaterChoice::Exact => WaterModelUsed::forced("exact"),
+            WaterChoice::Auto => WaterModelUsed {
+                chosen: "detected",
+                reason: "no streak to fit: nothing to compare".into(),
+                ..WaterModelUsed::forced("exact")
+            },
+        }
     } else {
         run.fit_lights(settings, &mut found)?
     };

@@ -11,6 +11,12 @@
 //! statistical model, unless the exact fit explains the photo all the same (at least
 //! [`EXACT_MIN_EXPLAINED`] of its variance over the fitted pixels: smooth water, which the
 //! exact model of a flat quad describes as it is, has no fine structure to correlate).
+//!
+//! A scene whose water is flat (slope variances under [`FLAT_SHARE`] of its material's) holds
+//! no waves whose fine structure could match: its exact model is the statistical model with
+//! the slopes fixed at the material's. The automatic choice then fits with the statistical
+//! model at once, so that the slopes are estimated from the photo (a game scene's quad
+//! carries a roughness that is a guess) and no exact fit is spent on the test.
 
 use serde::Serialize;
 
@@ -31,18 +37,22 @@ pub const EXACT_MIN_CORRELATION: f64 = 0.35;
 /// against its own mesh.
 pub const EXACT_MIN_EXPLAINED: f64 = 0.9;
 
+/// The share of the material's slope variance under which the water mesh's own slope
+/// variances (both) make it flat: waves that tilt the surface by less than a third of the
+/// microfacets' spread put no fine structure of their own into the reflections.
+pub const FLAT_SHARE: f32 = 0.1;
+
 /// Which water model to fit with.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum WaterChoice {
-    /// The scene's water mesh is the photo's water (the paper's setting). The default: the
-    /// automatic choice is not yet reliable on every scene (docs/decisions.md).
-    #[default]
+    /// The scene's water mesh is the photo's water (the paper's setting).
     Exact,
     /// The scene gives the mean surface; the waves are slope variances estimated from the
     /// photo.
     Statistical,
     /// The exact model if its fine structure matches the photo's, else the statistical one
-    /// (module doc).
+    /// (module doc). The default.
+    #[default]
     Auto,
 }
 
@@ -62,8 +72,10 @@ impl WaterChoice {
 pub struct WaterModelUsed {
     /// "exact" or "statistical".
     pub model: &'static str,
-    /// Why: "forced" by the settings, or "detected" (from `fine_structure_correlation`).
+    /// How: "forced" by the settings, or "detected" (from the scene's water and the photo).
     pub chosen: &'static str,
+    /// Why, in words, with the measured values the choice rested on.
+    pub reason: String,
     /// The correlation of the photo's fine structure with the exact model's (module doc);
     /// `None` where it was not measured.
     pub fine_structure_correlation: Option<f64>,

@@ -2,7 +2,10 @@
 //! statistical model's, and the automatic choice between them (the water_choice module's
 //! doc).
 
-use super::water_choice::{fine_structure, SlopesUsed, WaterChoice, WaterModelUsed};
+use super::water_choice::{
+    fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_EXPLAINED,
+    FLAT_SHARE,
+};
 use super::{Found, GlossFit, JointSettings, Method, Run, EXACT_MIN_CORRELATION};
 use crate::fitting::gloss::GlossSearch;
 use crate::fitting::joint::JointOptions;
@@ -19,6 +22,7 @@ impl WaterModelUsed {
         WaterModelUsed {
             model,
             chosen: "forced",
+            reason: format!("asked for (--water-model {model})"),
             fine_structure_correlation: None,
             threshold: EXACT_MIN_CORRELATION,
             exact_explained: None,
@@ -65,17 +69,28 @@ impl Run<'_> {
             (WaterChoice::Auto, method @ Method::Paper) => {
                 self.exact(method, found)?;
                 Ok(WaterModelUsed {
-                    chosen: "the paper's method: the exact model unless the statistical one \
-                             is asked for",
+                    chosen: "detected",
+                    reason: "the paper's method has no expected image to compare with the \
+                             photo: the exact model unless the statistical one is asked for"
+                        .into(),
                     ..WaterModelUsed::forced("exact")
                 })
             }
             (WaterChoice::Auto, method @ Method::Joint(j)) => {
+                if let Some(reason) = self.flat_water() {
+                    self.progress.stage(&format!(
+                        "{reason}: fitting with the statistical water model"
+                    ));
+                    let mut used = self.statistical(method, found, "detected", None)?;
+                    used.reason = reason;
+                    return Ok(used);
+                }
                 let warnings = found.warnings.len();
                 self.paper(found)?;
                 if found.lights.is_empty() {
                     return Ok(WaterModelUsed {
                         chosen: "detected",
+                        reason: "no light to fit: nothing to compare".into(),
                         ..WaterModelUsed::forced("exact")
                     });
                 }
@@ -96,6 +111,7 @@ impl Run<'_> {
                     }
                     return Ok(WaterModelUsed {
                         chosen: "detected",
+                        reason: choice_reason(fine),
                         fine_structure_correlation: correlation,
                         exact_explained,
                         ..WaterModelUsed::forced("exact")
@@ -112,9 +128,27 @@ impl Run<'_> {
                 found.skipped.clear();
                 let mut used = self.statistical(method, found, "detected", correlation)?;
                 used.exact_explained = exact_explained;
+                used.reason = choice_reason(fine);
                 Ok(used)
             }
         }
+    }
+
+    /// Why the scene's water is flat (module doc of `water_choice`), or `None` when it holds
+    /// waves (or the camera sees none of it: the fit then says so).
+    fn flat_water(&self) -> Option<String> {
+        let stats = water_statistics(self.scene, self.photo.width, self.photo.height)?;
+        let gloss = self.paper.model.gloss;
+        let micro = GaussianSlopes::from_gloss(gloss).variance;
+        let mesh = stats.slope_variance;
+        (mesh[0] < FLAT_SHARE * micro[0] && mesh[1] < FLAT_SHARE * micro[1]).then(|| {
+            format!(
+                "the scene's water is flat (slope variances {:.1e} along the view, {:.1e} \
+                 across, under a tenth of its material's {:.1e}): it holds no waves to match \
+                 the photo's, so their slopes are estimated from the photo",
+                mesh[0], mesh[1], micro[0]
+            )
+        })
     }
 
     /// The exact model's fit: the paper's estimate, the joint fit (the gloss estimated first
@@ -245,10 +279,36 @@ impl Run<'_> {
         Ok(WaterModelUsed {
             model: "statistical",
             chosen,
+            reason: "asked for (--water-model statistical)".into(),
             fine_structure_correlation: correlation,
             threshold: EXACT_MIN_CORRELATION,
             exact_explained: None,
             slopes: Some(slopes),
         })
+    }
+}
+
+/// Why the automatic choice went as it did, from the measured fine structure (`None`: too
+/// few pixels to measure, which keeps the exact model).
+fn choice_reason(fine: Option<FineStructure>) -> String {
+    let Some(f) = fine else {
+        return "too few fitted pixels to compare fine structures: the exact model".into();
+    };
+    let correlation = f
+        .correlation
+        .map_or("unmeasured".into(), |c| format!("{c:.2}"));
+    let explained = f.explained.map_or("unmeasured".into(), |e| format!("{e:.2}"));
+    if f.exact_fits() {
+        format!(
+            "the photo's fine structure matches the scene's waves (correlation {correlation}, \
+             threshold {EXACT_MIN_CORRELATION}) or the exact fit explains the photo \
+             ({explained} of its variance, threshold {EXACT_MIN_EXPLAINED})"
+        )
+    } else {
+        format!(
+            "the photo's fine structure does not match the scene's waves (correlation \
+             {correlation}, under {EXACT_MIN_CORRELATION}) and the exact fit explains only \
+             {explained} of the photo's variance (under {EXACT_MIN_EXPLAINED})"
+        )
     }
 }

@@ -44,6 +44,10 @@ struct DirectImage {
     first_pixel: usize,
     /// Its bounding rectangle on the plane, grown by half a pixel's footprint.
     rect: Rect,
+    /// Whether every pixel around the group sees the plane (dark or dim): the light ends
+    /// where its image ends, on every side. False where the frame's border, the water or
+    /// anything in front of the wall cuts the image, which may then hide part of the light.
+    enclosed: bool,
 }
 
 /// The starts moved onto their direct images and merged where they meet (module doc).
@@ -62,12 +66,12 @@ pub(super) fn direct_starts(
             .as_ref()
             .filter(|im| overlap(&light.rect(), &im.rect) < REPLACE_OVERLAP);
         let Some(im) = moved else {
-            on_image.push(
-                image
-                    .filter(|im| overlap(&light.rect(), &im.rect) >= REPLACE_OVERLAP)
-                    .map(|im| im.first_pixel),
-            );
-            out.push(light.clone());
+            let kept = image.filter(|im| overlap(&light.rect(), &im.rect) >= REPLACE_OVERLAP);
+            on_image.push(kept.as_ref().map(|im| im.first_pixel));
+            out.push(match kept {
+                Some(im) if im.enclosed => trimmed(light, &im.rect),
+                _ => light.clone(),
+            });
             continue;
         };
         let same_image = on_image.iter().position(|&o| o == Some(im.first_pixel));
@@ -106,6 +110,20 @@ pub(super) fn direct_starts(
         light.streak_ids.sort_unstable();
         light.streak_ids.dedup();
     }
+    out
+}
+
+/// `light` with every edge that reaches beyond its enclosed direct image `image` brought back
+/// to the image's edge: the reflections alone can stretch a start along a lobe far larger than
+/// the light (a grazing camera over glossy water gave a 3 m light a 10.96 m start, which the
+/// joint fit's local steps did not undo), while the dark pixels around the image say the
+/// light ends there. Two lamps sharing one image (stacked) keep their own starts inside it.
+fn trimmed(light: &FittedLight, image: &Rect) -> FittedLight {
+    let mut out = light.clone();
+    out.u_min = light.u_min.max(image.u_min);
+    out.u_max = light.u_max.min(image.u_max);
+    out.v_min = light.v_min.max(image.v_min);
+    out.v_max = light.v_max.min(image.v_max);
     out
 }
 
@@ -185,6 +203,24 @@ fn direct_image(
     };
     let bright: Vec<&(usize, Vec2, f32, f32)> = seen.iter().filter(|s| s.3 >= threshold).collect();
     let groups = groups_8(&bright.iter().map(|s| s.0).collect::<Vec<_>>(), w as usize);
+    let sees_plane: std::collections::HashSet<usize> = seen.iter().map(|s| s.0).collect();
+    // Every 8-neighbour of the group's pixels is in the frame and sees the plane.
+    let enclosed = |g: &[usize]| {
+        g.iter().all(|&m| {
+            let p = bright[m].0;
+            let (x, y) = ((p % w as usize) as i64, (p / w as usize) as i64);
+            (-1..=1i64).all(|dy| {
+                (-1..=1i64).all(|dx| {
+                    let (nx, ny) = (x + dx, y + dy);
+                    nx >= 0
+                        && ny >= 0
+                        && nx < w as i64
+                        && ny < h as i64
+                        && sees_plane.contains(&(ny as usize * w as usize + nx as usize))
+                })
+            })
+        })
+    };
     // One pixel's footprint on the plane at distance t, across: t times the pixel's angle.
     let pixel_angle = 2.0 * (scene.camera.yfov * 0.5).tan() / h as f32;
     let centre = start.center();
@@ -211,6 +247,7 @@ fn direct_image(
             DirectImage {
                 first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
                 rect: rect.grow(half_pixel),
+                enclosed: enclosed(&g),
             }
         })
         .min_by(|a, b| {
