@@ -297,7 +297,9 @@ fn choice_reason(fine: Option<FineStructure>) -> String {
     let correlation = f
         .correlation
         .map_or("unmeasured".into(), |c| format!("{c:.2}"));
-    let explained = f.explained.map_or("unmeasured".into(), |e| format!("{e:.2}"));
+    let explained = f
+        .explained
+        .map_or("unmeasured".into(), |e| format!("{e:.2}"));
     if f.exact_fits() {
         format!(
             "the photo's fine structure matches the scene's waves (correlation {correlation}, \

@@ -380,10 +380,54 @@ mod tests {
             );
         }
 
-        let close = truth.grow(0.2);
-        let kept = direct_starts(&scene, &photo, &water, &[light(&plane, close, 0)]);
+        let inside = truth.grow(-0.3);
+        let kept = direct_starts(&scene, &photo, &water, &[light(&plane, inside, 0)]);
         assert_eq!(kept.len(), 1);
-        assert_eq!(kept[0].rect(), close);
+        assert_eq!(kept[0].rect(), inside);
+    }
+
+    /// A start that overlaps the light's image well but reaches beyond it (as a grazing
+    /// camera's long lobes start one: 2 m below and 6 m above a 3 m light) is brought back to
+    /// the image's edges where the image is enclosed by pixels that see the wall, and every
+    /// edge then lies within a pixel's footprint of the truth; a start reaching 0.2 m beyond
+    /// on every side likewise. Where something else is seen right above the image (a row of
+    /// pixels marked as water), the image may be cut there and the start is kept.
+    #[test]
+    fn starts_beyond_an_enclosed_image_are_trimmed_to_it() {
+        let (scene, photo, water, plane, truth) = table1();
+        let footprint = 10.0 * 2.0 * (30f32.to_radians()).tan() / photo.height as f32;
+        let tall = Rect {
+            v_min: truth.v_min - 2.0,
+            v_max: truth.v_max + 6.0,
+            ..truth
+        };
+        for start in [tall, truth.grow(0.2)] {
+            let out = direct_starts(&scene, &photo, &water, &[light(&plane, start, 0)]);
+            assert_eq!(out.len(), 1);
+            let got = out[0].rect();
+            for (name, g, t) in [
+                ("left", got.u_min, truth.u_min),
+                ("right", got.u_max, truth.u_max),
+                ("bottom", got.v_min, truth.v_min),
+                ("top", got.v_max, truth.v_max),
+            ] {
+                assert!(
+                    (g - t).abs() < footprint,
+                    "{name} edge {g} against {t} (a pixel is {footprint} m)"
+                );
+            }
+        }
+        // The image's top row: the brightest clipped pixels' smallest y.
+        let top = (0..photo.radiance.len())
+            .filter(|&i| photo.clipped[i] && !water[i])
+            .map(|i| i / photo.width as usize)
+            .min()
+            .unwrap();
+        let mut cut = water.clone();
+        let row = (top - 1) * photo.width as usize;
+        cut[row..row + photo.width as usize].fill(true);
+        let out = direct_starts(&scene, &photo, &cut, &[light(&plane, tall, 0)]);
+        assert_eq!(out[0].rect(), tall);
     }
 
     #[test]
