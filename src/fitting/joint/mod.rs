@@ -68,6 +68,7 @@
 //! | `control_variate` | the lobe Gaussian |
 //! | `problem` | the fitted pixels with their samples, a fit's state |
 //! | `cost` | the cost, the coefficients' noise, the radiances' solve |
+//! | `colour` | a clipped channel's radiance from the light's colour where it is unclipped |
 //! | `ramps` | a coefficient at every grid position of one edge |
 //! | `profile` | the cost at every grid position of one edge |
 //! | `descent` | coordinate descent and its windows |
@@ -89,6 +90,7 @@ use crate::water_model::{ExactSurface, WaterModel};
 use crate::{Error, Result};
 
 mod boundary;
+mod colour;
 mod control_variate;
 mod cost;
 mod descent;
@@ -441,7 +443,7 @@ pub fn fit_joint_with(
     footprint_seconds += fresh_seconds.get();
     optimise_seconds -= fresh_seconds.get();
     let t2 = Instant::now();
-    let (st, spread) = if repeats.len() == 1 {
+    let (mut st, spread) = if repeats.len() == 1 {
         // One fit: the curvature alone (see `uncertainties`). With the control variate it
         // covers the errors (8 seeds through the pipeline: Table 3 0.5-1.3 sigma rms, largest
         // 2.1; the stacked sample 0.3-1.2, largest 1.8); adding the spread of two refits, one
@@ -459,6 +461,8 @@ pub fn fit_joint_with(
         // The mean's radiances, not the ones the first fit's samples would give its edges.
         (State { radiance, ..st }, Some(spread))
     };
+    // The channels a light clips: from its colour in the pixels it does not (`colour`).
+    colour::colour_from_unclipped(&problem, &mut st);
     let cost = problem.cost(&st);
     let dof = (problem.n() * 3).saturating_sub(7 * st.rects.len()).max(1) as f64;
     let variance = (cost / dof).max(f64::MIN_POSITIVE);
