@@ -8,16 +8,12 @@ import path from "node:path";
 import { fileURLToPath } from "node:url";
 
 const ROOT = path.dirname(fileURLToPath(import.meta.url));
+// A browser insists on the type of the page and of its ES modules only; GLTFLoader reads the
+// scene's files (.gltf, .bin, images) whatever type they come with.
 const TYPES = {
   ".html": "text/html; charset=utf-8",
   ".js": "text/javascript; charset=utf-8",
-  ".mjs": "text/javascript; charset=utf-8",
   ".json": "application/json",
-  ".gltf": "model/gltf+json",
-  ".glb": "model/gltf-binary",
-  ".bin": "application/octet-stream",
-  ".png": "image/png",
-  ".jpg": "image/jpeg",
 };
 
 const server = createServer((req, res) => {

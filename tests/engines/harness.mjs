@@ -171,6 +171,8 @@ export async function openPage(browser, url) {
   };
   page.on("console", (m) => note(`[${m.type()}] ${m.text()}`));
   page.on("pageerror", (e) => note(`[pageerror] ${e.message}`));
+  // The console's "Failed to load resource" does not say which: name it.
+  page.on("response", (r) => r.status() >= 400 && note(`[error] HTTP ${r.status()} for ${r.url()}`));
   await page.goto(url);
   return { page, log };
 }

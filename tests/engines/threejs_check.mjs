@@ -37,9 +37,23 @@ try {
   await refusesOutside(example.origin);
   const scene = encodeURIComponent(`${server.origin}/lit/${encodeURIComponent(path.basename(litPath))}`);
   const { page, log } = await openPage(browser, `${example.origin}/?scene=${scene}&size=600`);
+  // An error in the page (a module of the import map or the scene it cannot load) may stop
+  // its script before it can report: fail at once, instead of at the timeout.
+  let finished = false;
+  const erred = (async () => {
+    while (!finished && !log.some((l) => l.startsWith("[error]") || l.startsWith("[pageerror]"))) {
+      await new Promise((resolve) => setTimeout(resolve, 200));
+    }
+    if (!finished) throw new Error("an error in the page");
+  })();
   try {
-    await page.waitForFunction(() => window.streaklightResult || window.streaklightError, null, { timeout: 90000 });
+    await Promise.race([
+      page.waitForFunction(() => window.streaklightResult || window.streaklightError, null, { timeout: 90000 }),
+      erred,
+    ]);
+    finished = true;
   } catch (e) {
+    finished = true;
     throw new Error(`the example page never finished: ${e.message.split("\n")[0]}\n  page log:\n    ${log.join("\n    ")}`);
   }
   const error = await page.evaluate(() => window.streaklightError);
