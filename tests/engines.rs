@@ -1,14 +1,14 @@
 //! A real engine reads our lights. Babylon.js's own glTF loader (which imports
 //! `EXT_lights_area`) loads a lit scene in headless Chromium; `tests/engines/babylon_check.mjs`
-//! checks the lights it created against the report, and this test checks its screenshots.
+//! checks the lights it created against the report, and this test checks its screenshots. The
+//! three.js example (`examples/threejs/`), served by its own `npm start` server with its own
+//! three, does the same through its GLTFLoader plugin (`tests/engines/threejs_check.mjs`).
 //!
-//! Needs Node, `npm ci --prefix tests/engines` and Debian's Chromium, which `scripts/test`
-//! installs; without them the test fails and says so.
+//! Needs Node, `npm ci --prefix tests/engines`, `npm ci --prefix examples/threejs` and Debian's
+//! Chromium, which `scripts/test` installs; without them the test fails and says so.
 //!
-//! The lit scene and its report are made here from the paper's Table 3 lights with
-//! `write_lit_scene`, in the shape `streaklight fit --report` writes. To check a real fit
-//! instead, make [`lit_scene_and_report`] run `streaklight fit SCENE PHOTO -o OUT --report
-//! REPORT.json` and return (OUT, REPORT): the Node script reads only those two files.
+//! The lit scene and its report are a real `fit` of the Table 3 sample photo with `--report`
+//! ([`lit_scene_and_report`]): the Node scripts read only those two files.
 
 mod common;
 

@@ -8,7 +8,7 @@ pub const ENGINES_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/engine
 
 /// What to do when Node, its packages or Chromium are missing.
 pub const INSTALL: &str = "run `scripts/test`, which installs Node.js, Debian's Chromium and \
-     `npm ci --prefix tests/engines`";
+     `npm ci --prefix tests/engines` (and `--prefix examples/threejs`)";
 
 /// Runs `node tests/engines/SCRIPT ARGS...`; panics with its output unless it succeeds.
 /// Returns its stdout.

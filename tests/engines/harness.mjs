@@ -69,7 +69,8 @@ const MIME = {
 /**
  * Serves `mounts` ({ "/prefix/": directory }) and `blobs` ({ "/path": Buffer }) on 127.0.0.1
  * at a free port. Paths that leave their mount are refused. Every request is logged, so a
- * failing run shows what the page asked for.
+ * failing run shows what the page asked for. Any origin may read the files (CORS), so that a
+ * page served elsewhere (the three.js example's own server) can load a scene from here.
  */
 export async function startServer(mounts, blobs = {}) {
   const requests = [];
@@ -89,7 +90,10 @@ export async function startServer(mounts, blobs = {}) {
       const inside = file === path.resolve(dir) || file.startsWith(path.resolve(dir) + path.sep);
       if (inside && existsSync(file) && statSync(file).isFile()) {
         requests.push({ path: pathname, status: 200 });
-        res.writeHead(200, { "content-type": MIME[path.extname(file)] ?? "application/octet-stream" });
+        res.writeHead(200, {
+          "content-type": MIME[path.extname(file)] ?? "application/octet-stream",
+          "access-control-allow-origin": "*",
+        });
         createReadStream(file).pipe(res);
         return;
       }
@@ -105,10 +109,10 @@ export async function startServer(mounts, blobs = {}) {
 /**
  * Launches Debian's Chromium headless through playwright-core (no browser download), with a
  * new empty profile, software WebGL (SwiftShader: there is no GPU), and every request that
- * leaves `origin` aborted and recorded, so a hidden CDN dependency fails the check instead of
- * hanging on the closed network.
+ * leaves `origins` (one or a list) aborted and recorded, so a hidden CDN dependency fails the
+ * check instead of hanging on the closed network.
  */
-export async function launchBrowser(origin) {
+export async function launchBrowser(origins) {
   const { chromium } = await requirePackage("playwright-core");
   const executablePath = process.env.STREAKLIGHT_CHROMIUM ?? "/usr/bin/chromium";
   if (!existsSync(executablePath)) fail(`no Chromium at ${executablePath}: ${CHROMIUM_HINT}`, 2);
@@ -139,7 +143,8 @@ export async function launchBrowser(origin) {
   const blocked = [];
   await context.route("**/*", (route) => {
     const url = route.request().url();
-    if (url.startsWith(origin + "/") || url.startsWith("data:") || url.startsWith("blob:")) {
+    const local = [origins].flat().some((origin) => url.startsWith(origin + "/"));
+    if (local || url.startsWith("data:") || url.startsWith("blob:")) {
       return route.continue();
     }
     blocked.push(url);
@@ -166,6 +171,8 @@ export async function openPage(browser, url) {
   };
   page.on("console", (m) => note(`[${m.type()}] ${m.text()}`));
   page.on("pageerror", (e) => note(`[pageerror] ${e.message}`));
+  // The console's "Failed to load resource" does not say which: name it.
+  page.on("response", (r) => r.status() >= 400 && note(`[error] HTTP ${r.status()} for ${r.url()}`));
   await page.goto(url);
   return { page, log };
 }

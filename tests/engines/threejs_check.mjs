@@ -1,40 +1,59 @@
-// Smoke test of the three.js example:
+// Smoke test of the three.js example, run the way its README says:
 //
 //   node tests/engines/threejs_check.mjs --gltf OUT.gltf --report REPORT.json --screenshot shot.png
 //
-// Opens examples/threejs/index.html (GLTFLoader + examples/threejs/ext-lights-area-plugin.js,
-// three from this folder's node_modules) on OUT.gltf in headless Chromium and checks that the
-// RectAreaLights the plugin made match REPORT.json. three.js is right-handed like glTF, so
-// world coordinates compare directly. Exit codes as babylon_check.mjs.
+// Starts the example's own server (its package.json's `start` script, on a free port), opens
+// its page (examples/threejs/index.html: GLTFLoader + ext-lights-area-plugin.js, three from
+// examples/threejs/node_modules) on OUT.gltf in headless Chromium, and checks that the
+// RectAreaLights the plugin made match REPORT.json. OUT.gltf is served from a second local
+// server (with CORS), as `?scene=URL`. three.js is right-handed like glTF, so world coordinates
+// compare directly. Exit codes as babylon_check.mjs.
 
-import { writeFileSync } from "node:fs";
+import { spawn } from "node:child_process";
+import { existsSync, readFileSync, writeFileSync } from "node:fs";
 import path from "node:path";
 import {
-  HERE, cross, dot, expectedLights, fail, fmt, launchBrowser, norm, openPage, parseArgs,
-  requireModuleFile, scale, startServer, sub, unit,
+  HERE, cross, dot, expectedLights, fail, fmt, launchBrowser, norm, openPage, parseArgs, scale,
+  startServer, sub, unit,
 } from "./harness.mjs";
 
 const args = parseArgs(process.argv.slice(2), ["gltf", "report", "screenshot"]);
 const WATCHDOG_SECONDS = 180;
 setTimeout(() => fail(`no result after ${WATCHDOG_SECONDS} s`), WATCHDOG_SECONDS * 1000).unref();
 const REL = 1e-4; // three keeps matrices in float32, as Babylon does: see babylon_check.mjs
+const EXAMPLE = path.resolve(HERE, "../../examples/threejs");
+const EXAMPLE_HINT = "run `npm ci --prefix examples/threejs` from the repository root";
 
-requireModuleFile("three/build/three.module.js");
+const threeVersion = exampleThree();
 const { lights: expected } = expectedLights(args.report);
 if (expected.length === 0) fail(`${args.report} lists no written light: nothing to check`, 2);
 
-const repo = path.resolve(HERE, "../..");
 const litPath = path.resolve(args.gltf);
-// The page's import map reaches three at ../../tests/engines/node_modules: serve the repository.
-const server = await startServer({ "/lit/": path.dirname(litPath), "/": repo });
-const browser = await launchBrowser(server.origin);
+const example = await startExample();
+const server = await startServer({ "/lit/": path.dirname(litPath) });
+const browser = await launchBrowser([example.origin, server.origin]);
 const problems = [];
 try {
-  const scene = encodeURIComponent(`/lit/${path.basename(litPath)}`);
-  const { page, log } = await openPage(browser, `${server.origin}/examples/threejs/index.html?scene=${scene}&size=600`);
+  await refusesOutside(example.origin);
+  const scene = encodeURIComponent(`${server.origin}/lit/${encodeURIComponent(path.basename(litPath))}`);
+  const { page, log } = await openPage(browser, `${example.origin}/?scene=${scene}&size=600`);
+  // An error in the page (a module of the import map or the scene it cannot load) may stop
+  // its script before it can report: fail at once, instead of at the timeout.
+  let finished = false;
+  const erred = (async () => {
+    while (!finished && !log.some((l) => l.startsWith("[error]") || l.startsWith("[pageerror]"))) {
+      await new Promise((resolve) => setTimeout(resolve, 200));
+    }
+    if (!finished) throw new Error("an error in the page");
+  })();
   try {
-    await page.waitForFunction(() => window.streaklightResult || window.streaklightError, null, { timeout: 90000 });
+    await Promise.race([
+      page.waitForFunction(() => window.streaklightResult || window.streaklightError, null, { timeout: 90000 }),
+      erred,
+    ]);
+    finished = true;
   } catch (e) {
+    finished = true;
     throw new Error(`the example page never finished: ${e.message.split("\n")[0]}\n  page log:\n    ${log.join("\n    ")}`);
   }
   const error = await page.evaluate(() => window.streaklightError);
@@ -53,10 +72,74 @@ try {
 } finally {
   await browser.close();
   await server.close();
+  example.close();
 }
 if (browser.blocked.length) problems.push(`the page tried to reach the network (blocked): ${browser.blocked.join(", ")}`);
 if (problems.length) fail(`${problems.length} problem(s):\n  - ${problems.join("\n  - ")}`);
-console.log(`three.js: all ${expected.length} RectAreaLight(s) match the report`);
+console.log(`three.js ${threeVersion}: all ${expected.length} RectAreaLight(s) match the report`);
+
+function readJson(file) {
+  try {
+    return JSON.parse(readFileSync(file, "utf8"));
+  } catch (e) {
+    return fail(`cannot read ${file}: ${e.message}`, 2);
+  }
+}
+
+/**
+ * The version of three the example installed, after checking that it is the one its
+ * package.json pins and the one this folder pins (for the Babylon check's LTC tables), so
+ * that both engines' results stay comparable.
+ */
+function exampleThree() {
+  const pinned = readJson(path.join(EXAMPLE, "package.json")).dependencies?.three;
+  const ours = readJson(path.join(HERE, "package.json")).dependencies?.three;
+  if (pinned !== ours) {
+    fail(`examples/threejs/package.json pins three ${pinned}, tests/engines/package.json ${ours}: pin one version in both`);
+  }
+  const installed = path.join(EXAMPLE, "node_modules/three/package.json");
+  if (!existsSync(installed)) fail(`examples/threejs/node_modules/three is missing: ${EXAMPLE_HINT}`, 2);
+  const version = readJson(installed).version;
+  if (version !== pinned) fail(`examples/threejs/node_modules holds three ${version}, its package.json pins ${pinned}: ${EXAMPLE_HINT}`, 2);
+  return version;
+}
+
+/** Runs the example's `npm start` command (`node SCRIPT`) on a free port; returns its origin. */
+async function startExample() {
+  const start = readJson(path.join(EXAMPLE, "package.json")).scripts?.start ?? "";
+  const [command, ...rest] = start.split(" ");
+  if (command !== "node") fail(`examples/threejs/package.json's start script is ${JSON.stringify(start)}, not \`node SCRIPT\``, 2);
+  const child = spawn(process.execPath, rest, {
+    cwd: EXAMPLE,
+    env: { ...process.env, PORT: "0" },
+    stdio: ["ignore", "pipe", "pipe"],
+  });
+  process.on("exit", () => child.kill()); // also when fail() exits early
+  let output = "";
+  const origin = await new Promise((resolve, reject) => {
+    const read = (data) => {
+      output += data;
+      const url = output.match(/^open (http:\/\/[^/\s]+)\/$/m);
+      if (url) resolve(url[1]);
+    };
+    child.stdout.on("data", read);
+    child.stderr.on("data", read);
+    child.on("error", reject);
+    child.on("exit", (code) => reject(new Error(`exited with code ${code}:\n${output}`)));
+  }).catch((e) => fail(`\`${start}\` in examples/threejs did not start serving: ${e.message}`, 2));
+  return { origin, close: () => child.kill() };
+}
+
+/** The example's server must not hand out files outside its folder. */
+async function refusesOutside(origin) {
+  const inside = await fetch(`${origin}/package.json`);
+  if (inside.status !== 200) problems.push(`the example's server answers ${inside.status} for its own package.json`);
+  // The repository's README.md, two folders up. "%2f" is not a path separator to the URL
+  // parser, so the ".." segments reach the server undecoded.
+  if (!existsSync(path.join(EXAMPLE, "../../README.md"))) fail("no README.md in the repository root", 2);
+  const outside = await fetch(`${origin}/..%2f..%2fREADME.md`);
+  if (outside.status !== 404) problems.push(`the example's server answers ${outside.status} for ../../README.md, outside its folder`);
+}
 
 function compare(made) {
   if (made.length !== expected.length) {
