@@ -102,7 +102,7 @@ pub struct SlopesUsed {
     /// What the start came from.
     pub start_source: String,
     /// Whether the variances were estimated from the photo (false: the start was used as
-    /// it is, by the paper's method).
+    /// it is, by the paper's method, or no light was found to estimate them with).
     pub estimated: bool,
     /// Pixels per independent residual of the final fit (the glitter's correlation area):
     /// every uncertainty was grown by its square root; `None` for the paper's method.

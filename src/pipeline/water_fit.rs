@@ -265,13 +265,16 @@ impl Run<'_> {
                 found.warnings.extend(est.warnings);
                 found.timings.extend(est.timings);
                 found.reading = Some(j.reading);
-                self.refit_overlaps(&est.water, &est.start, &final_fit, j, found)?;
+                let estimated = !found.lights.is_empty();
+                if estimated {
+                    self.refit_overlaps(&est.water, &est.start, &final_fit, j, found)?;
+                }
                 SlopesUsed {
                     variance: est.variance,
                     sigma_ln: est.sigma_ln,
                     start_variance: est.start_variance,
                     start_source,
-                    estimated: true,
+                    estimated,
                     correlation_area: Some(est.correlation_area),
                 }
             }

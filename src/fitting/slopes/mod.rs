@@ -126,6 +126,11 @@ pub fn estimate_slopes(
     let mut timings = Vec::new();
     let t = Instant::now();
     let start_water = water_with_total(surface, start_variance);
+    final_fit.progress.stage(&format!(
+        "fit of {} streak(s): the paper's estimate over the statistical water (the slope \
+         search's start)",
+        streaks.len()
+    ));
     let paper_fit = fit_paper_with(
         &start_water,
         scene,
@@ -135,6 +140,25 @@ pub fn estimate_slopes(
         &FitOptions { model, ..*paper },
     )?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
+    if paper_fit.lights.is_empty() {
+        // No light to estimate the slopes with: the caller reports the streaks skipped, as
+        // the exact model's fit does.
+        return Ok(SlopeEstimate {
+            water: start_water,
+            variance: start_variance,
+            sigma_ln: [None, None],
+            start_variance,
+            evaluations: Vec::new(),
+            lights: Vec::new(),
+            uncertainty: Vec::new(),
+            start: Vec::new(),
+            skipped: paper_fit.skipped,
+            warnings: paper_fit.warnings,
+            timings,
+            cost: 0.0,
+            correlation_area: 1.0,
+        });
+    }
     let start = search_start(&paper_fit, streaks.len(), "waves' slope")?;
     let mut warnings = paper_fit.warnings.clone();
     let broad = water_with_total(surface, start_variance.map(|v| (4.0 * v).min(hi)));
@@ -241,8 +265,10 @@ pub fn estimate_slopes(
         ));
     }
     final_fit.progress.stage(&format!(
-        "slope search: final joint fit at variances {:.2e} along, {:.2e} across",
-        variance[0], variance[1]
+        "slope search: final joint fit of {} light(s) at variances {:.2e} along, {:.2e} across",
+        start.len(),
+        variance[0],
+        variance[1]
     ));
     let t = Instant::now();
     let at = water_with_total(surface, variance);
