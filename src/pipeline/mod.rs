@@ -395,6 +395,7 @@ impl Run<'_> {
         found.skipped = estimate.skipped;
         found.warnings.extend(estimate.warnings);
         found.timings = estimate.timings;
+        found.modelled = estimate.modelled;
         let at_estimate = JointOptions {
             model: ReflectionModel {
                 gloss: estimate.gloss,

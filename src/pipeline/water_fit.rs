@@ -6,7 +6,7 @@ use super::water_choice::{
     fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_EXPLAINED,
     FLAT_SHARE,
 };
-use super::{Found, GlossFit, JointSettings, Method, Run, EXACT_MIN_CORRELATION};
+use super::{Found, GlossFit, Method, Run, EXACT_MIN_CORRELATION};
 use crate::fitting::gloss::GlossSearch;
 use crate::fitting::joint::JointOptions;
 use crate::fitting::slopes::{estimate_slopes, water_with_total, MICROFACET_GLOSS};
@@ -76,7 +76,7 @@ impl Run<'_> {
                     ..WaterModelUsed::forced("exact")
                 })
             }
-            (WaterChoice::Auto, method @ Method::Joint(j)) => {
+            (WaterChoice::Auto, method @ Method::Joint(_)) => {
                 if let Some(reason) = self.flat_water() {
                     self.progress.stage(&format!(
                         "{reason}: fitting with the statistical water model"
@@ -86,7 +86,9 @@ impl Run<'_> {
                     return Ok(used);
                 }
                 let warnings = found.warnings.len();
-                self.paper(found)?;
+                // The exact fit as it would be made alone (with the gloss search when asked),
+                // then the test on its expected image: where it passes, nothing is done twice.
+                self.exact(method, found)?;
                 if found.lights.is_empty() {
                     return Ok(WaterModelUsed {
                         chosen: "detected",
@@ -94,21 +96,10 @@ impl Run<'_> {
                         ..WaterModelUsed::forced("exact")
                     });
                 }
-                self.refine(
-                    &JointSettings {
-                        gloss: GlossFit::Given,
-                        ..*j
-                    },
-                    found,
-                )?;
                 let fine = fine_structure(&self.photo.radiance, self.photo.width, &found.modelled);
                 let correlation = fine.and_then(|f| f.correlation);
                 let exact_explained = fine.and_then(|f| f.explained);
                 if fine.is_none_or(|f| f.exact_fits()) {
-                    if matches!(j.gloss, GlossFit::Estimate(_)) {
-                        found.warnings.truncate(warnings);
-                        self.with_gloss_search(j, found)?;
-                    }
                     return Ok(WaterModelUsed {
                         chosen: "detected",
                         reason: choice_reason(fine),

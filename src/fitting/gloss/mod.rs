@@ -213,6 +213,9 @@ pub struct GlossEstimate {
     /// Wall-clock seconds per stage: "paper fit", "search (N evaluations)", "final joint
     /// fit".
     pub timings: Vec<(String, f64)>,
+    /// The final joint fit's expected image: its fitted water pixels with their modelled
+    /// radiance ([`super::joint::JointOutcome::modelled`]).
+    pub modelled: Vec<(u32, [f32; 3])>,
 }
 
 /// Estimates the water's gloss from the photo and fits the lights with it (see the module
@@ -351,6 +354,7 @@ pub fn estimate_gloss(
         skipped: paper.skipped,
         warnings,
         timings,
+        modelled: final_fit.modelled,
     })
 }
 

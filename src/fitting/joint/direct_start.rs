@@ -47,7 +47,12 @@ struct DirectImage {
     /// Whether every pixel around the group sees the plane (dark or dim): the light ends
     /// where its image ends, on every side. False where the frame's border, the water or
     /// anything in front of the wall cuts the image, which may then hide part of the light.
+    /// For the image chosen for a start: and so are all the others the start overlaps.
     enclosed: bool,
+    /// For the image chosen for a start: the bounding rectangle of every image the start
+    /// overlaps, what the start is trimmed to (two stacked lamps are two images under one
+    /// start).
+    reach: Rect,
 }
 
 /// The starts moved onto their direct images and merged where they meet (module doc).
@@ -69,7 +74,7 @@ pub(super) fn direct_starts(
             let kept = image.filter(|im| overlap(&light.rect(), &im.rect) >= REPLACE_OVERLAP);
             on_image.push(kept.as_ref().map(|im| im.first_pixel));
             out.push(match kept {
-                Some(im) if im.enclosed => trimmed(light, &im.rect),
+                Some(im) if im.enclosed => trimmed(light, &im.reach),
                 _ => light.clone(),
             });
             continue;
@@ -224,7 +229,7 @@ fn direct_image(
     // One pixel's footprint on the plane at distance t, across: t times the pixel's angle.
     let pixel_angle = 2.0 * (scene.camera.yfov * 0.5).tan() / h as f32;
     let centre = start.center();
-    groups
+    let images: Vec<DirectImage> = groups
         .into_iter()
         .filter(|g| g.len() >= MIN_PIXELS)
         .map(|g| {
@@ -248,12 +253,36 @@ fn direct_image(
                 first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
                 rect: rect.grow(half_pixel),
                 enclosed: enclosed(&g),
+                reach: rect.grow(half_pixel),
             }
         })
+        .collect();
+    // What the start may be trimmed to: every image it overlaps (two stacked lamps the
+    // reflections started as one light are two images), enclosed only if all of them are.
+    let overlapped: Vec<&DirectImage> = images
+        .iter()
+        .filter(|im| overlap(&start, &im.rect) > 0.0)
+        .collect();
+    let reach = overlapped.iter().fold(None, |acc: Option<Rect>, im| {
+        Some(acc.map_or(im.rect, |r| Rect {
+            u_min: r.u_min.min(im.rect.u_min),
+            u_max: r.u_max.max(im.rect.u_max),
+            v_min: r.v_min.min(im.rect.v_min),
+            v_max: r.v_max.max(im.rect.v_max),
+        }))
+    });
+    let all_enclosed = overlapped.iter().all(|im| im.enclosed);
+    images
+        .into_iter()
         .min_by(|a, b| {
             let da = (a.rect.center() - centre).length();
             let db = (b.rect.center() - centre).length();
             da.total_cmp(&db)
+        })
+        .map(|im| DirectImage {
+            enclosed: im.enclosed && all_enclosed,
+            reach: reach.unwrap_or(im.rect),
+            ..im
         })
 }
 
@@ -417,12 +446,33 @@ mod tests {
                 );
             }
         }
-        // The image's top row: the brightest clipped pixels' smallest y.
-        let top = (0..photo.radiance.len())
+        // The image's rows: the clipped pixels' off the water.
+        let rows: Vec<usize> = (0..photo.radiance.len())
             .filter(|&i| photo.clipped[i] && !water[i])
             .map(|i| i / photo.width as usize)
-            .min()
-            .unwrap();
+            .collect();
+        let (top, bottom) = (*rows.iter().min().unwrap(), *rows.iter().max().unwrap());
+        // Two stacked lamps: the image cut in two by three dark rows across its middle. A
+        // start over both, reaching 0.2 m beyond them (overlapping each by more than a
+        // quarter), is trimmed to both, not to the one nearer its centre.
+        let mut stacked = photo.clone();
+        let middle = (top + bottom) / 2;
+        for i in (middle - 1) * photo.width as usize..(middle + 2) * photo.width as usize {
+            stacked.radiance[i] = [0.0; 3];
+            stacked.clipped[i] = false;
+        }
+        let out = direct_starts(
+            &scene,
+            &stacked,
+            &water,
+            &[light(&plane, truth.grow(0.2), 0)],
+        );
+        let got = out[0].rect();
+        assert!(
+            (got.v_min - truth.v_min).abs() < footprint
+                && (got.v_max - truth.v_max).abs() < footprint,
+            "{got:?} against {truth:?}"
+        );
         let mut cut = water.clone();
         let row = (top - 1) * photo.width as usize;
         cut[row..row + photo.width as usize].fill(true);
