@@ -1,6 +1,7 @@
 //! Writes the seed corpus into `fuzz/seeds/{scene_loader,photo_decoder}`: small valid scenes
 //! (`.gltf` with data: URIs, `.glb`, indexed, stripped, sparse, with a hierarchy and an area
-//! light) and tiny photos in every format the decoder reads. Run from `fuzz/`:
+//! light) and tiny photos in every format the decoder reads (one EXR with negative values, one
+//! JPEG with the EXIF that `--exposure auto` reads). Run from `fuzz/`:
 //! `cargo run --example make_seeds`. The seeds are committed; rerun only to change them.
 
 use std::path::Path;
@@ -190,6 +191,41 @@ fn photos(dir: &Path, samples: &Path) {
     let float = DynamicImage::ImageRgb32F(small.to_rgb32f());
     save(&float, "table1-small.hdr", ImageFormat::Hdr);
     save(&DynamicImage::ImageRgba32F(small.to_rgba32f()), "table1-small.exr", ImageFormat::OpenExr);
+    // Below zero in places (a denoiser's undershoot): the decoder reads them as 0 and warns.
+    let mut negative = small.to_rgb32f();
+    negative.pixels_mut().step_by(5).for_each(|p| p.0[1] = -0.25);
+    save(&DynamicImage::ImageRgb32F(negative), "table1-small-negative.exr", ImageFormat::OpenExr);
+    // `--exposure auto` reads these from the EXIF: a JPEG with it in an APP1 segment.
+    let mut jpeg = std::io::Cursor::new(Vec::new());
+    small.to_rgb8().write_to(&mut jpeg, ImageFormat::Jpeg).unwrap();
+    let jpeg = jpeg.into_inner();
+    let mut payload = b"Exif\0\0".to_vec();
+    payload.extend(camera_exif());
+    let mut with_exif = vec![0xff, 0xd8, 0xff, 0xe1];
+    with_exif.extend(u16::try_from(payload.len() + 2).unwrap().to_be_bytes());
+    with_exif.extend(payload);
+    with_exif.extend(&jpeg[2..]);
+    write(dir, "table1-small-exif.jpg", &with_exif);
+}
+
+/// TIFF-structured EXIF of a night shot: 1/30 s, f/2.8, ISO 800.
+fn camera_exif() -> Vec<u8> {
+    use exif::{Field, In, Rational, Tag, Value};
+    let field = |tag, value| Field { tag, ifd_num: In::PRIMARY, value };
+    let rational = |num, denom| Value::Rational(vec![Rational { num, denom }]);
+    let fields = [
+        field(Tag::Software, Value::Ascii(vec![b"streaklight seeds".to_vec()])),
+        field(Tag::ExposureTime, rational(1, 30)),
+        field(Tag::FNumber, rational(28, 10)),
+        field(Tag::PhotographicSensitivity, Value::Short(vec![800])),
+    ];
+    let mut writer = exif::experimental::Writer::new();
+    for f in &fields {
+        writer.push_field(f);
+    }
+    let mut out = std::io::Cursor::new(Vec::new());
+    writer.write(&mut out, false).unwrap();
+    out.into_inner()
 }
 
 fn main() {
