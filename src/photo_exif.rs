@@ -75,7 +75,12 @@ fn round_to(x: f64, digits: i32) -> f64 {
 /// The exposure of the photo at `path` from its EXIF, and the text that says where it came
 /// from ("EXIF: 1/30 s, f/2.8, ISO 800, K = 12.5, middle grey 0.18"); errors as [`read`].
 pub fn exposure_of(path: &Path) -> Result<(f32, String)> {
-    let camera = read(path)?;
+    exposure_from_bytes(&crate::input_file::read(path)?, path)
+}
+
+/// As [`exposure_of`], from the bytes of the photo's file; `path` names it in messages.
+pub fn exposure_from_bytes(bytes: &[u8], path: &Path) -> Result<(f32, String)> {
+    let camera = from_bytes(bytes, path)?;
     let exposure = camera.exposure() as f32;
     if !(exposure.is_finite() && exposure > 0.0) {
         return Err(Error::photo(
@@ -95,10 +100,10 @@ pub fn exposure_of(path: &Path) -> Result<(f32, String)> {
 
 /// The camera settings in the EXIF of the photo at `path` (JPEG, PNG with an eXIf chunk,
 /// TIFF). An error naming the photo when it has no EXIF, or the EXIF lacks the exposure
-/// time, the f-number or the ISO speed, or holds a value that is not a positive number.
+/// time, the f-number or the ISO speed, or holds a value that is not a positive number; the
+/// file is read as every input is ([`crate::input_file::read`]: regular files only, bounded).
 pub fn read(path: &Path) -> Result<CameraSettings> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    from_bytes(&bytes, path)
+    from_bytes(&crate::input_file::read(path)?, path)
 }
 
 /// As [`read`], from the bytes of the photo's file; `path` names it in messages.

@@ -10,7 +10,7 @@ use std::path::Path;
 use common::gltf_builder::{data_uri, glb, vec3_bytes};
 use serde_json::{json, Value};
 use streaklight::scene_in::{load, load_from_bytes, LoadOptions};
-use streaklight::{photo_in, Error};
+use streaklight::{photo_exif, photo_in, Error};
 
 /// A camera and a water triangle, with `bin` as the one buffer (a data: URI).
 fn scene(bin: &[u8]) -> Value {
@@ -296,10 +296,12 @@ fn fuzzer_found_scenes_do_not_panic() {
     });
 }
 
-/// Every file under tests/data/fuzz/photo_decoder: inputs the fuzzer found.
+/// Every file under tests/data/fuzz/photo_decoder: inputs the fuzzer found, read as `fit`
+/// reads a photo (its EXIF for `--exposure auto`, then the pixels).
 #[test]
 fn fuzzer_found_photos_give_clean_errors() {
     for_each_file("photo_decoder", |name, bytes| {
+        let _ = exposure(bytes);
         assert!(decode(bytes).is_err(), "{name} decoded");
     });
 }
@@ -323,6 +325,10 @@ fn for_each_file(target: &str, check: impl Fn(&str, &[u8])) {
 
 fn decode(bytes: &[u8]) -> streaklight::Result<photo_in::Photo> {
     photo_in::decode(bytes, 1.0, Path::new("fuzz.png"))
+}
+
+fn exposure(bytes: &[u8]) -> streaklight::Result<(f32, String)> {
+    photo_exif::exposure_from_bytes(bytes, Path::new("fuzz.png"))
 }
 
 fn crc32(bytes: &[u8]) -> u32 {
@@ -392,10 +398,15 @@ fn truncated_and_unknown_photos_are_clean_errors() {
         assert!(decode(&bytes).is_ok(), "{} does not decode", path.display());
         for len in (0..bytes.len()).step_by(7) {
             let _ = decode(&bytes[..len]);
+            let _ = exposure(&bytes[..len]);
         }
     }
     assert!(decode(b"").is_err());
     assert!(decode(b"not an image at all").is_err());
+    // The seed with EXIF: 1/30 s, f/2.8, ISO 800.
+    let (_, source) =
+        exposure(&std::fs::read(seeds.join("table1-small-exif.jpg")).unwrap()).unwrap();
+    assert!(source.contains("1/30 s, f/2.8, ISO 800"), "{source}");
 }
 
 #[test]

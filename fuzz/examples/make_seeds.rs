@@ -1,6 +1,7 @@
 //! Writes the seed corpus into `fuzz/seeds/{scene_loader,photo_decoder}`: small valid scenes
 //! (`.gltf` with data: URIs, `.glb`, indexed, stripped, sparse, with a hierarchy and an area
-//! light) and tiny photos in every format the decoder reads. Run from `fuzz/`:
+//! light) and tiny photos in every format the decoder reads (one EXR with negative values, one
+//! JPEG with the EXIF that `--exposure auto` reads). Run from `fuzz/`:
 //! `cargo run --example make_seeds`. The seeds are committed; rerun only to change them.
 
 use std::path::Path;
@@ -99,7 +100,11 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) {
 fn scenes(dir: &Path) {
     let mut bin = Vec::new();
     let doc = base_scene(&mut bin);
-    write(dir, "grid.gltf", &serde_json::to_vec_pretty(&with_data_uri(doc.clone(), &bin)).unwrap());
+    write(
+        dir,
+        "grid.gltf",
+        &serde_json::to_vec_pretty(&with_data_uri(doc.clone(), &bin)).unwrap(),
+    );
     let mut glb_doc = doc.clone();
     glb_doc["buffers"][0]["byteLength"] = json!(bin.len());
     write(dir, "grid.glb", &glb(&glb_doc, &bin));
@@ -121,7 +126,11 @@ fn scenes(dir: &Path) {
         {"type": "rect", "size": 1.0, "rect": {"aspect": 2.0}, "intensity": 50.0, "color": [1.0, 0.9, 0.8]}
     ]}});
     d["extensionsRequired"] = json!(["EXT_lights_area"]);
-    write(dir, "strip_hierarchy_light.gltf", &serde_json::to_vec(&with_data_uri(d, &bin)).unwrap());
+    write(
+        dir,
+        "strip_hierarchy_light.gltf",
+        &serde_json::to_vec(&with_data_uri(d, &bin)).unwrap(),
+    );
 
     // A sparse accessor: positions all zero but for two, and u8 indices in a fan.
     let mut d = doc.clone();
@@ -136,21 +145,40 @@ fn scenes(dir: &Path) {
         "min": [0.0, 0.0, -3.0], "max": [1.0, 0.0, 0.0],
         "sparse": {"count": 2, "indices": {"bufferView": 3, "componentType": 5121},
                    "values": {"bufferView": 4}}});
-    d["accessors"][2] = json!({"bufferView": 5, "componentType": 5121, "count": 5, "type": "SCALAR"});
+    d["accessors"][2] =
+        json!({"bufferView": 5, "componentType": 5121, "count": 5, "type": "SCALAR"});
     d["bufferViews"].as_array_mut().unwrap().extend([
         json!({"buffer": 0, "byteOffset": sparse_at, "byteLength": 2}),
         json!({"buffer": 0, "byteOffset": sparse_at + 4, "byteLength": 24}),
         json!({"buffer": 0, "byteOffset": fan_at, "byteLength": 5}),
     ]);
     d["meshes"][0]["primitives"][0]["mode"] = json!(6);
-    write(dir, "sparse_fan.glb", &glb(&{ let mut g = d.clone(); g["buffers"][0]["byteLength"] = json!(b.len()); g }, &b));
+    write(
+        dir,
+        "sparse_fan.glb",
+        &glb(
+            &{
+                let mut g = d.clone();
+                g["buffers"][0]["byteLength"] = json!(b.len());
+                g
+            },
+            &b,
+        ),
+    );
 
     // Strided interleaved positions and normals, u32 indices, several scenes.
     let mut d = doc;
     let mut b = Vec::new();
     for j in 0..3 {
         for i in 0..3 {
-            b.extend(floats(&[i as f32 - 1.0, 0.0, -(j as f32) - 2.0, 0.0, 1.0, 0.0]));
+            b.extend(floats(&[
+                i as f32 - 1.0,
+                0.0,
+                -(j as f32) - 2.0,
+                0.0,
+                1.0,
+                0.0,
+            ]));
         }
     }
     let idx_at = b.len();
@@ -169,7 +197,11 @@ fn scenes(dir: &Path) {
     ]);
     d["scenes"] = json!([{"nodes": [0]}, {"nodes": [0, 1]}]);
     d["scene"] = json!(1);
-    write(dir, "interleaved.gltf", &serde_json::to_vec(&with_data_uri(d, &b)).unwrap());
+    write(
+        dir,
+        "interleaved.gltf",
+        &serde_json::to_vec(&with_data_uri(d, &b)).unwrap(),
+    );
 }
 
 fn photos(dir: &Path, samples: &Path) {
@@ -182,14 +214,89 @@ fn photos(dir: &Path, samples: &Path) {
         write(dir, name, bytes.get_ref());
     };
     save(&small, "table1-small.png", ImageFormat::Png);
-    save(&DynamicImage::ImageRgb8(small.to_rgb8()), "table1-small.jpg", ImageFormat::Jpeg);
-    save(&DynamicImage::ImageRgb16(small.to_rgb16()), "table1-small-16bit.png", ImageFormat::Png);
-    save(&DynamicImage::ImageRgba8(small.to_rgba8()), "table1-small.tiff", ImageFormat::Tiff);
+    save(
+        &DynamicImage::ImageRgb8(small.to_rgb8()),
+        "table1-small.jpg",
+        ImageFormat::Jpeg,
+    );
+    save(
+        &DynamicImage::ImageRgb16(small.to_rgb16()),
+        "table1-small-16bit.png",
+        ImageFormat::Png,
+    );
+    save(
+        &DynamicImage::ImageRgba8(small.to_rgba8()),
+        "table1-small.tiff",
+        ImageFormat::Tiff,
+    );
     let dark = image::open(samples.join("dark.png")).unwrap();
-    save(&dark.resize_exact(16, 16, image::imageops::FilterType::Nearest).to_luma8().into(), "dark-small-gray.png", ImageFormat::Png);
+    save(
+        &dark
+            .resize_exact(16, 16, image::imageops::FilterType::Nearest)
+            .to_luma8()
+            .into(),
+        "dark-small-gray.png",
+        ImageFormat::Png,
+    );
     let float = DynamicImage::ImageRgb32F(small.to_rgb32f());
     save(&float, "table1-small.hdr", ImageFormat::Hdr);
-    save(&DynamicImage::ImageRgba32F(small.to_rgba32f()), "table1-small.exr", ImageFormat::OpenExr);
+    save(
+        &DynamicImage::ImageRgba32F(small.to_rgba32f()),
+        "table1-small.exr",
+        ImageFormat::OpenExr,
+    );
+    // Below zero in places (a denoiser's undershoot): the decoder reads them as 0 and warns.
+    let mut negative = small.to_rgb32f();
+    negative
+        .pixels_mut()
+        .step_by(5)
+        .for_each(|p| p.0[1] = -0.25);
+    save(
+        &DynamicImage::ImageRgb32F(negative),
+        "table1-small-negative.exr",
+        ImageFormat::OpenExr,
+    );
+    // `--exposure auto` reads these from the EXIF: a JPEG with it in an APP1 segment.
+    let mut jpeg = std::io::Cursor::new(Vec::new());
+    small
+        .to_rgb8()
+        .write_to(&mut jpeg, ImageFormat::Jpeg)
+        .unwrap();
+    let jpeg = jpeg.into_inner();
+    let mut payload = b"Exif\0\0".to_vec();
+    payload.extend(camera_exif());
+    let mut with_exif = vec![0xff, 0xd8, 0xff, 0xe1];
+    with_exif.extend(u16::try_from(payload.len() + 2).unwrap().to_be_bytes());
+    with_exif.extend(payload);
+    with_exif.extend(&jpeg[2..]);
+    write(dir, "table1-small-exif.jpg", &with_exif);
+}
+
+/// TIFF-structured EXIF of a night shot: 1/30 s, f/2.8, ISO 800.
+fn camera_exif() -> Vec<u8> {
+    use exif::{Field, In, Rational, Tag, Value};
+    let field = |tag, value| Field {
+        tag,
+        ifd_num: In::PRIMARY,
+        value,
+    };
+    let rational = |num, denom| Value::Rational(vec![Rational { num, denom }]);
+    let fields = [
+        field(
+            Tag::Software,
+            Value::Ascii(vec![b"streaklight seeds".to_vec()]),
+        ),
+        field(Tag::ExposureTime, rational(1, 30)),
+        field(Tag::FNumber, rational(28, 10)),
+        field(Tag::PhotographicSensitivity, Value::Short(vec![800])),
+    ];
+    let mut writer = exif::experimental::Writer::new();
+    for f in &fields {
+        writer.push_field(f);
+    }
+    let mut out = std::io::Cursor::new(Vec::new());
+    writer.write(&mut out, false).unwrap();
+    out.into_inner()
 }
 
 fn main() {

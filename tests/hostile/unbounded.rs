@@ -15,6 +15,14 @@ fn fifo(path: &Path) {
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
 }
 
+/// `args` with `--exposure auto` in place of the exposure they give.
+#[cfg(unix)]
+fn exposure_auto(mut args: Vec<String>) -> Vec<String> {
+    let at = args.iter().position(|a| a == "--exposure").unwrap();
+    args[at + 1] = "auto".into();
+    args
+}
+
 #[cfg(unix)]
 #[test]
 fn fifos_and_devices_are_refused_within_a_second() {
@@ -29,6 +37,15 @@ fn fifos_and_devices_are_refused_within_a_second() {
         (fit(zero, &c.photo, &["-o", &arg(&out)]), "device"),
         (fit(&c.scene, zero, &["-o", &arg(&out)]), "device"),
         (fit(&c.scene, &c.dir, &["-o", &arg(&out)]), "folder"),
+        // `--exposure auto` reads the photo's EXIF before the photo itself.
+        (
+            exposure_auto(fit(&c.scene, &pipe, &["-o", &arg(&out)])),
+            "FIFO",
+        ),
+        (
+            exposure_auto(fit(&c.scene, zero, &["-o", &arg(&out)])),
+            "device",
+        ),
     ];
     for (args, word) in cases {
         let ran = refused(&args, &[], &[&c.dir], &[word, "regular files"]);
