@@ -352,6 +352,21 @@ mod tests {
         (scene, photo, water, plane, rect)
     }
 
+    /// Every edge of `got` within `footprint` (a pixel's, on the wall) of `truth`'s.
+    fn assert_within(got: &Rect, truth: &Rect, footprint: f32) {
+        for (name, g, t) in [
+            ("left", got.u_min, truth.u_min),
+            ("right", got.u_max, truth.u_max),
+            ("bottom", got.v_min, truth.v_min),
+            ("top", got.v_max, truth.v_max),
+        ] {
+            assert!(
+                (g - t).abs() < footprint,
+                "{name} edge {g} against {t} (a pixel is {footprint} m)"
+            );
+        }
+    }
+
     fn light(plane: &LightPlane, rect: Rect, streak: usize) -> FittedLight {
         let free = || EdgeStatus::Constrained { pixels: 1 };
         FittedLight {
@@ -397,17 +412,7 @@ mod tests {
         assert_eq!(out[0].streak_ids, vec![0, 1]);
         let got = out[0].rect();
         let footprint = 10.0 * 2.0 * (30f32.to_radians()).tan() / photo.height as f32;
-        for (name, g, t) in [
-            ("left", got.u_min, truth.u_min),
-            ("right", got.u_max, truth.u_max),
-            ("bottom", got.v_min, truth.v_min),
-            ("top", got.v_max, truth.v_max),
-        ] {
-            assert!(
-                (g - t).abs() < footprint,
-                "{name} edge {g} against {t} (a pixel is {footprint} m)"
-            );
-        }
+        assert_within(&got, &truth, footprint);
 
         let inside = truth.grow(-0.3);
         let kept = direct_starts(&scene, &photo, &water, &[light(&plane, inside, 0)]);
@@ -434,17 +439,7 @@ mod tests {
             let out = direct_starts(&scene, &photo, &water, &[light(&plane, start, 0)]);
             assert_eq!(out.len(), 1);
             let got = out[0].rect();
-            for (name, g, t) in [
-                ("left", got.u_min, truth.u_min),
-                ("right", got.u_max, truth.u_max),
-                ("bottom", got.v_min, truth.v_min),
-                ("top", got.v_max, truth.v_max),
-            ] {
-                assert!(
-                    (g - t).abs() < footprint,
-                    "{name} edge {g} against {t} (a pixel is {footprint} m)"
-                );
-            }
+            assert_within(&got, &truth, footprint);
         }
         // The image's rows: the clipped pixels' off the water.
         let rows: Vec<usize> = (0..photo.radiance.len())
