@@ -629,8 +629,12 @@ fn debug_dir_shows_photo_render_and_difference() {
     let img = image::open(debug.join("fit-photo-render-difference.png"))
         .unwrap()
         .into_rgb8();
-    // Three titled panels 4 px apart, their pictures aligned at the bottom.
-    assert_eq!(img.width(), 3 * SIDE + 8);
+    // Titled panels 4 px apart, their pictures aligned at the bottom: three, and a fourth
+    // because this flat scene is fitted with the statistical model (the report says so): the
+    // scene's own water (the exact model) with the same lights.
+    let statistical = read_json(&report)["water_model"]["model"] == "statistical";
+    assert!(statistical, "the flat quad takes the statistical model");
+    assert_eq!(img.width(), 4 * SIDE + 12);
     assert!(img.height() > SIDE, "titles above the panels");
     let top = img.height() - SIDE;
     let at = |k: u32, x: u32, y: u32| img.get_pixel(k * (SIDE + 4) + x, top + y).0;
@@ -659,6 +663,13 @@ fn debug_dir_shows_photo_render_and_difference() {
     };
     let (photo_sum, render_sum) = (panel(0), panel(1));
     assert!(photo_sum > 0.0);
+    // The exact model's image of the same lights carries about the same reflected light as
+    // the statistical one (the flat quad's lobe is the start the slopes were estimated from).
+    let exact_sum = panel(3);
+    assert!(
+        (exact_sum / render_sum - 1.0).abs() < 0.5,
+        "exact {exact_sum}, statistical {render_sum}"
+    );
     // The re-render carries the fitted light's reflection (this low-quality case fits a
     // different rectangle, so only its presence is checked).
     assert!(

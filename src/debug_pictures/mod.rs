@@ -321,7 +321,29 @@ fn fit_picture(
             Key::new([0, 0, 0], "0, or not water"),
         ],
     );
-    Ok(side_by_side(&[photo_panel, model_panel, residual_panel]))
+    let mut panels = vec![photo_panel, model_panel, residual_panel];
+    // Under the statistical model, the other model's image beside it: what the scene's own
+    // water would reflect (its glints are where its waves put them, not the photo's).
+    if statistical.is_some() {
+        options.progress.stage(
+            "debug pictures: the scene's own water with the fitted lights (the exact model)",
+        );
+        let exact = render_lights(scene, &area, photo, MODEL_SPP, options, None)?;
+        let exact: Vec<[f32; 3]> = exact
+            .iter()
+            .zip(water)
+            .map(|(m, &w)| if w { *m } else { [0.0; 3] })
+            .collect();
+        panels.push(with_header(
+            &srgb_image(width, height, &exact),
+            &format!(
+                "Not used: the scene's own water mesh with the same lights (the exact model, \
+                 {MODEL_SPP} rays per pixel); the report's water_model says why"
+            ),
+            &[],
+        ));
+    }
+    Ok(side_by_side(&panels))
 }
 
 #[cfg(test)]
