@@ -314,6 +314,7 @@ impl Run<'_> {
         found.lights = outcome.lights_with_statuses();
         found.uncertainties = outcome.uncertainty;
         found.modelled = outcome.modelled;
+        found.warnings.extend(outcome.warnings);
         Ok(())
     }
 

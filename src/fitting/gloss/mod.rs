@@ -339,6 +339,7 @@ pub fn estimate_gloss(
     )?;
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
     let lights = final_fit.lights_with_statuses();
+    warnings.extend(final_fit.warnings);
     Ok(GlossEstimate {
         gloss,
         sigma_ln: found.sigma_ln.map(|s| s as f32),

@@ -74,6 +74,7 @@
 //! | `descent` | coordinate descent and its windows |
 //! | `optimise` | descent, split, boundary search, descent; repeats' replay |
 //! | `split`, `boundary` | overlapping streaks: the cut, the boundary search |
+//! | `significance` | lights the photo cannot tell from nothing, dropped |
 //! | `repeats` | the mean of repeated fits and its standard error |
 //! | `uncertainty` | uncertainties, facing edges, edge statuses |
 
@@ -106,6 +107,7 @@ mod ramps;
 mod region;
 mod repeats;
 mod samples;
+mod significance;
 mod split;
 mod uncertainty;
 
@@ -212,6 +214,9 @@ pub struct JointOutcome {
     /// radiance at the optimum, per channel: the expected image the photo was compared with
     /// (the direct view's pixels left out).
     pub modelled: Vec<(u32, [f32; 3])>,
+    /// Things the user should know: the lights dropped because the photo cannot tell them
+    /// from nothing (`significance`), with why.
+    pub warnings: Vec<String>,
 }
 
 impl JointOutcome {
@@ -280,6 +285,7 @@ pub fn fit_joint_with(
             cost: 0.0,
             timings: Vec::new(),
             modelled: Vec::new(),
+            warnings: Vec::new(),
         });
     }
     // Starts far from the lights' direct images are moved onto them (`direct_start`).
@@ -461,17 +467,45 @@ pub fn fit_joint_with(
         // The mean's radiances, not the ones the first fit's samples would give its edges.
         (State { radiance, ..st }, Some(spread))
     };
-    // The channels a light clips: from its colour in the pixels it does not (`colour`).
-    colour::colour_from_unclipped(&problem, &mut st);
+    let mut spread = spread;
+    let mut uncertainty = finish(&problem, &mut st, &extents, spread.as_deref());
+    // Lights the photo cannot tell from nothing are dropped, the others fitted again
+    // without them (`significance`).
+    let dropped = significance::insignificant(&problem, &st, &uncertainty);
+    let mut warnings = Vec::new();
+    if !dropped.is_empty() {
+        for (k, why) in dropped.iter().rev() {
+            let (r, l) = (st.rects[*k], st.radiance[*k]);
+            let origin = &start[problem.set_origin[st.set_of[*k]]];
+            warnings.push(format!(
+                "a light of streak(s) {:?} ({:.2} x {:.2} m, radiance {:.3}, {:.3}, {:.3}) \
+                 was dropped: {why}",
+                origin.streak_ids,
+                r.width(),
+                r.height(),
+                l[0],
+                l[1],
+                l[2]
+            ));
+            significance::remove(&mut st, *k);
+            if let Some(s) = spread.as_mut() {
+                s.remove(*k);
+            }
+        }
+        warnings.reverse();
+        options.progress.stage(&format!(
+            "joint fit: descent of {} light(s) after dropping {} the photo cannot tell from \
+             nothing",
+            st.rects.len(),
+            dropped.len()
+        ));
+        problem.solve_radiance(&mut st);
+        problem.descend(&mut st, &extents, options.sweeps);
+        uncertainty = finish(&problem, &mut st, &extents, spread.as_deref());
+    }
     let cost = problem.cost(&st);
     let dof = (problem.n() * 3).saturating_sub(7 * st.rects.len()).max(1) as f64;
     let variance = (cost / dof).max(f64::MIN_POSITIVE);
-    let mut uncertainty = uncertainties(&problem, &st, &extents);
-    // The repeats' spread, where there are several, adds to the curvature's.
-    for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
-        u.edges = EdgeSide::ALL.map(|e| u.edges[e].map(|sd| sd.hypot(edges[e as usize])));
-        u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
-    }
     optimise_seconds += t2.elapsed().as_secs_f64();
     // The water pixels alone: the direct view's sharp image of a light would match the photo
     // whatever the water model.
@@ -536,5 +570,24 @@ pub fn fit_joint_with(
             ("optimise".into(), optimise_seconds),
         ],
         modelled,
+        warnings,
     })
+}
+
+/// The last steps of a fit: the channels a light clips from its colour in the pixels it does
+/// not (`colour`), then the uncertainties, the repeats' `spread` (one per light, where there
+/// are several repeats) added to the curvature's.
+fn finish(
+    problem: &Problem,
+    st: &mut State,
+    extents: &[Option<Rect>],
+    spread: Option<&[([f32; 4], [f32; 3])]>,
+) -> Vec<Uncertainty> {
+    colour::colour_from_unclipped(problem, st);
+    let mut uncertainty = uncertainties(problem, st, extents);
+    for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
+        u.edges = EdgeSide::ALL.map(|e| u.edges[e].map(|sd| sd.hypot(edges[e as usize])));
+        u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
+    }
+    uncertainty
 }

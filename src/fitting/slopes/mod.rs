@@ -285,6 +285,7 @@ pub fn estimate_slopes(
         },
     )?;
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
+    warnings.extend(fit.warnings.iter().cloned());
     let area = correlation_area(&photo.radiance, photo.width, &fit.modelled);
     let sigma_ln = sigma_ln.map(|s| s.map(|s| s * area.sqrt() as f32));
     let lights = fit.lights_with_statuses();
