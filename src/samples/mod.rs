@@ -20,6 +20,7 @@
 pub mod gltf_doc;
 pub mod harbour;
 pub mod harbour_waves;
+mod mesh_size;
 pub mod shapes;
 pub mod water_surface;
 
@@ -32,6 +33,7 @@ use crate::{Error, Result};
 
 use gltf_doc::{CameraPose, Quad, SceneParts, Solid, WaterBuffer, WaterGeometry};
 use harbour::Framing;
+pub use mesh_size::{finer_water_grid, write_paper_scenes_on_grid};
 use water_surface::{GridSpec, RippleField};
 
 /// The paper's camera position.
@@ -407,8 +409,13 @@ impl WaterBuffers {
     }
 }
 
-/// The parts of `spec`'s scene file.
-fn scene_parts<'a>(spec: &'a SampleScene, buffers: &'a WaterBuffers) -> SceneParts<'a> {
+/// The parts of `spec`'s scene file, its water meshes taken from `paper` or `harbour` (each
+/// the photos' own waves, then the other realisation) by its setup.
+fn scene_parts<'a>(
+    spec: &'a SampleScene,
+    paper: &'a [WaterBuffer],
+    harbour: &'a [WaterBuffer],
+) -> SceneParts<'a> {
     let (camera, solids, flat, meshes, uris) = match spec.setup {
         Setup::Paper => (
             CameraPose {
@@ -419,14 +426,14 @@ fn scene_parts<'a>(spec: &'a SampleScene, buffers: &'a WaterBuffers) -> ScenePar
             },
             vec![paper_wall(spec.wall_z)],
             paper_flat_water(),
-            &buffers.paper,
+            paper,
             [WATER_BIN, OTHER_WATER_BIN],
         ),
         Setup::Harbour(framing) => (
             harbour::camera(framing),
             harbour::solids(),
             harbour::flat_water(),
-            &buffers.harbour,
+            harbour,
             [harbour::HARBOUR_WATER_BIN, harbour::HARBOUR_OTHER_WATER_BIN],
         ),
     };
@@ -460,9 +467,12 @@ pub fn write_scenes(dir: &Path) -> Result<Vec<PathBuf>> {
     }
     for spec in catalogue() {
         let path = dir.join(&spec.file);
-        let text =
-            serde_json::to_string_pretty(&gltf_doc::scene_json(&scene_parts(&spec, &buffers)))
-                .map_err(|e| Error::output(&path, e.to_string()))?;
+        let text = serde_json::to_string_pretty(&gltf_doc::scene_json(&scene_parts(
+            &spec,
+            &buffers.paper,
+            &buffers.harbour,
+        )))
+        .map_err(|e| Error::output(&path, e.to_string()))?;
         write_atomically(&path, text.as_bytes())?;
         written.push(path);
     }
