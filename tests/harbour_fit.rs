@@ -141,13 +141,11 @@ fn known_slope_variances_are_recovered_from_an_isotropic_start() {
         "estimated {:?} from {:?}",
         slopes.variance, slopes.start_variance
     );
-    for axis in 0..2 {
-        let error = slopes.variance[axis] as f64 / truth[axis] as f64 - 1.0;
+    for (axis, (&got, &want)) in slopes.variance.iter().zip(&truth).enumerate() {
+        let error = got as f64 / want as f64 - 1.0;
         assert!(
             error.abs() < 0.05,
-            "axis {axis}: {} against {} ({slopes:?})",
-            slopes.variance[axis],
-            truth[axis]
+            "axis {axis}: {got} against {want} ({slopes:?})"
         );
     }
     assert_pair(&scene, &lit);
