@@ -32,7 +32,8 @@ pub enum Command {
     /// and write them into the scene.
     #[command(allow_negative_numbers = true, after_help = cli::fit::AFTER_HELP)]
     Fit(cli::fit::Args),
-    /// Find the streaks (reflections of lights) in a photo and draw pictures of every stage.
+    /// Find the streaks (reflections of lights) in a photo, one per light as `fit` fits them
+    /// (fragments of one light merged), and draw pictures of every stage.
     #[command(allow_negative_numbers = true, after_help = cli::exit::SEGMENT_HELP)]
     Segment(cli::segment::Args),
     /// Render the water and the EXT_lights_area lights of a scene as its camera sees them.

@@ -11,12 +11,14 @@ use std::sync::OnceLock;
 use common::json::{read_json, schema_validator};
 use common::pipeline::{sample_photo, sample_photo_path, sample_scene, sample_scenes};
 use glam::{DVec3, Vec3};
+use streaklight::fitting::{fragments, FitOptions};
 use streaklight::photo_in::Photo;
 use streaklight::random::Rng;
 use streaklight::samples::{self, SampleLight};
 use streaklight::scene_in::Scene;
 use streaklight::streaks::{extract_streaks, BoundingBox, Segmentation, StreakParams, StreakSide};
 use streaklight::water_mask::water_mask;
+use streaklight::water_model::ExactSurface;
 
 struct Setup {
     scene: Scene,
@@ -231,8 +233,9 @@ fn table1_light_over_rough_water_gives_one_streak() {
     assert!(streak.pixels.len() > 1000);
 }
 
-/// The streaks of the smooth-water sample lie on the light's reflection; how many there are
-/// is the ignored test below.
+/// The streaks of the smooth-water sample lie on the light's reflection. The extraction
+/// finds two: a band of brighter ripples (columns 97-264, rows 380-421) grows from its own
+/// seed inside the main streak (columns 61-272, rows 330-599).
 #[test]
 fn table1_light_over_smooth_water_gives_streaks_only_on_its_reflection() {
     let (_, photo) = samples::gloss_sample_files(samples::SAMPLE_GLOSSES[1]);
@@ -250,13 +253,48 @@ fn table1_light_over_smooth_water_gives_streaks_only_on_its_reflection() {
     }
 }
 
+/// The extraction's streaks with the fragments of one light merged, as `segment` and `fit`
+/// merge them (the scene's water at gloss `gloss`).
+fn lights_segment(photo: &Photo, gloss: f32) -> Segmentation {
+    let scene = sample_scene("scene.gltf", Some(gloss));
+    let pieces = segment(photo);
+    let observations: Vec<_> = pieces
+        .streaks
+        .iter()
+        .map(|s| streaklight::pipeline::observation(s, photo.width))
+        .collect();
+    let (groups, _) = fragments::lights(
+        &ExactSurface,
+        &scene,
+        photo,
+        &setup().water,
+        &observations,
+        &FitOptions::for_scene(&scene),
+    );
+    pieces.merged(photo, &groups)
+}
+
+/// Both streaks of the smooth-water sample are one light's: merged, they are one streak where
+/// geometry puts the light's reflection, made of both.
 #[test]
-#[ignore = "the default segmentation splits gloss1000.png in two: a band of brighter ripples \
-            (columns 97-264, rows 380-421, 4217 pixels) grows from its own seed inside the \
-            main streak (columns 61-272, rows 330-599); with render seed 2 it is one streak"]
 fn table1_light_over_smooth_water_gives_one_streak() {
-    let seg = segment(&sample_photo("gloss1000.png"));
+    let photo = sample_photo("gloss1000.png");
+    let seg = lights_segment(&photo, 1000.0);
     check_matches(&seg, &[samples::table1_light()]);
+    assert_eq!(seg.streaks[0].fragments, vec![0, 1]);
+    // One streak holds both fragments' pixels, and its edges are the union's.
+    let pieces = segment(&photo);
+    let total: usize = pieces.streaks.iter().map(|s| s.pixels.len()).sum();
+    assert_eq!(seg.streaks[0].pixels.len(), total);
+}
+
+/// Merging leaves streaks of different lights apart.
+#[test]
+fn table3_lights_stay_two_streaks_when_fragments_are_merged() {
+    let seg = lights_segment(&sample_photo("table3.png"), 500.0);
+    check_matches(&seg, &samples::table3_lights());
+    let fragments: Vec<&[usize]> = seg.streaks.iter().map(|s| &s.fragments[..]).collect();
+    assert_eq!(fragments, [&[0][..], &[1][..]]);
 }
 
 #[test]
@@ -324,7 +362,7 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
         "0.1",
     ]);
     assert!(ok, "{stderr}");
-    assert!(stdout.contains("streak 1:"), "{stdout}");
+    assert!(stdout.contains("streak 1 (fragments 1):"), "{stdout}");
     for name in ["superpixels.png", "seeds.png", "streaks.png", "edges.png"] {
         // The photo's size, under a title and a key.
         let img = image::open(out.join(name)).unwrap();
@@ -339,10 +377,39 @@ fn segment_command_writes_pictures_and_a_report_that_matches_its_schema() {
         .collect();
     assert!(errors.is_empty(), "{errors:?}");
     assert_eq!(report["streaks"].as_array().unwrap().len(), 2);
+    assert_eq!(report["fragments"].as_array().unwrap().len(), 2);
     // The schema is not vacuous: a report missing a field fails it.
     let mut broken = report.clone();
     broken["streaks"][0].as_object_mut().unwrap().remove("bbox");
     assert!(!validator.is_valid(&broken));
+
+    // Fragments of one light are one streak, which lists them; the report keeps them too.
+    let out_smooth = common::temp_dir("segment-cli-smooth");
+    let (ok, stdout, stderr) = common::run_cli(&[
+        "segment",
+        scene.to_str().unwrap(),
+        sample_photo_path("gloss1000.png").to_str().unwrap(),
+        "--out-dir",
+        out_smooth.to_str().unwrap(),
+        "--exposure",
+        "0.1",
+        "--gloss",
+        "1000",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("streak 0 (fragments 0, 1):"), "{stdout}");
+    assert!(!stdout.contains("streak 1"), "{stdout}");
+    let report = read_json(&out_smooth.join("streaks.json"));
+    assert!(validator.is_valid(&report));
+    assert_eq!(report["streaks"].as_array().unwrap().len(), 1);
+    assert_eq!(report["streaks"][0]["fragments"], serde_json::json!([0, 1]));
+    let pieces = report["fragments"].as_array().unwrap();
+    assert_eq!(pieces.len(), 2);
+    let pixels = |v: &serde_json::Value| v["pixel_count"].as_u64().unwrap();
+    assert_eq!(
+        pixels(&report["streaks"][0]),
+        pieces.iter().map(pixels).sum::<u64>()
+    );
 
     // No lights: the command fails clearly and writes nothing (a refused run leaves no file).
     let dark = sample_photo_path("dark.png");

@@ -2,8 +2,10 @@
 
 use std::path::PathBuf;
 
+use streaklight::fitting::{fragments, FitOptions, Skipped};
 use streaklight::scene_in::{self, LoadOptions};
 use streaklight::streaks::{self, pictures, report};
+use streaklight::water_model::ExactSurface;
 
 use super::streak_args::StreakArgs;
 use super::values::ExposureArg;
@@ -31,13 +33,26 @@ pub struct Args {
     /// Water node or mesh name (default: the one node whose name contains "water").
     #[arg(long)]
     pub water: Option<String>,
+    /// Blinn-Phong gloss e of the water (dimensionless, > 0; typical 100-2000, rough to calm;
+    /// the samples: 200-1000), overriding its material's roughness: the lobe with which the
+    /// streaks' lights are placed to tell fragments of one light from two lights, as `fit`
+    /// does.
+    #[arg(long, value_name = "E", value_parser = super::values::positive_f32)]
+    pub gloss: Option<f32>,
+    /// Index of refraction of the water, above 1 (dimensionless; water 1.33; default: its
+    /// material's KHR_materials_ior, else 1.33).
+    #[arg(long, value_name = "N", value_parser = super::values::ior)]
+    pub ior: Option<f32>,
     /// Streak-extraction settings.
     #[command(flatten)]
     pub streak: StreakArgs,
 }
 
 /// Runs the command. Nothing is written unless streaks are found; the pictures and
-/// streaks.json are then written together ([`output_file::Run`]).
+/// streaks.json are then written together ([`output_file::Run`]). The streaks are those of
+/// the lights `fit` fits: fragments of one light (method §5 step 5) are merged as `fit` merges them
+/// ([`fragments::lights`], under the scene's own water mesh), and each streak lists
+/// the fragments it is made of.
 pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
     let params = args.streak.params()?;
     output_file::ensure_folder_writable(&args.out_dir)?;
@@ -62,6 +77,8 @@ pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
         &LoadOptions {
             camera: args.camera,
             water: args.water,
+            gloss: args.gloss,
+            ior: args.ior,
             ..LoadOptions::default()
         },
     )?;
@@ -74,23 +91,52 @@ pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
         Error::NothingFound(m) => Error::NothingFound(format!("{}: {m}", args.photo.display())),
         other => other,
     };
-    let seg = streaks::extract_streaks(&photo, &water, &params).map_err(in_photo)?;
-    seg.require_streaks()
+    let pieces = streaks::extract_streaks(&photo, &water, &params).map_err(in_photo)?;
+    pieces
+        .require_streaks()
         .map_err(|e| Error::NothingFound(format!("{}: {e}", args.photo.display())))?;
+    let observations: Vec<_> = pieces
+        .streaks
+        .iter()
+        .map(|s| streaklight::pipeline::observation(s, photo.width))
+        .collect();
+    let (groups, grouping) = fragments::lights(
+        &ExactSurface,
+        &scene,
+        &photo,
+        &water,
+        &observations,
+        &FitOptions::for_scene(&scene),
+    );
+    for w in &grouping.warnings {
+        out.warn(w);
+    }
+    for skipped in &grouping.skipped {
+        let (Skipped::NoPlane { streak, message } | Skipped::NoSolution { streak, message }) =
+            skipped;
+        out.warn(&format!(
+            "streak {streak} of the extraction gave no light, so it is merged with none: \
+             {message}"
+        ));
+    }
+    let seg = pieces.merged(&photo, &groups);
 
     output_file::create_dir_all(&args.out_dir)?;
     let mut written = pictures::write_pictures(&args.out_dir, &photo, &water, &seg)?;
     let json = args.out_dir.join(pictures::STREAKS_JSON);
-    report::write_report(&json, &seg, &params)?;
+    report::write_report(&json, &seg, Some(&pieces), &params)?;
     written.push(json);
     run.commit()?;
     for p in &written {
         println!("wrote {}", p.display());
     }
     for s in &seg.streaks {
+        let fragments: Vec<String> = s.fragments.iter().map(|f| f.to_string()).collect();
         println!(
-            "streak {}: {} pixels, columns {}-{}, rows {}-{}, brightest pixel ({}, {})",
+            "streak {} (fragments {}): {} pixels, columns {}-{}, rows {}-{}, brightest pixel \
+             ({}, {})",
             s.id,
+            fragments.join(", "),
             s.pixels.len(),
             s.bbox.x_min,
             s.bbox.x_max,

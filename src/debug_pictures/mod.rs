@@ -90,7 +90,7 @@ pub fn write(
         });
     }
     let json = dir.join(streaks::pictures::STREAKS_JSON);
-    streaks::report::write_report(&json, &lit.segmentation, &options.fit.streaks)?;
+    streaks::report::write_report(&json, &lit.segmentation, None, &options.fit.streaks)?;
     written.push(json);
 
     let fit = fit_picture(scene, photo, lit, options)?;

@@ -46,7 +46,9 @@ pub fn assign(fp: &Footprint, rect: &Rect) -> Option<EdgeSide> {
     })
 }
 
-/// Solves `c(p; rect with edge side moved to x) = coef` for x.
+/// Solves `c(p; rect with edge side moved to x) = coef` for x; `min_band` is the narrowest
+/// half-width over which the slope there is measured (a share of the light's distance, for
+/// a rectangle too small to give one).
 ///
 /// Samples outside the three held edges never count; of the rest, those on the inner side of
 /// x do. Walking them from the far (inner) side, the cumulative weight crosses `coef` between
@@ -56,7 +58,13 @@ pub fn assign(fp: &Footprint, rect: &Rect) -> Option<EdgeSide> {
 /// The weight is `slope^2 / coef`, with `slope = |dc/dx|` at the solution: the photo's Monte
 /// Carlo and quantisation noise and the footprint's own noise all have a variance roughly
 /// proportional to `c`, so `coef / slope^2` is the variance of x up to a common factor.
-pub fn solve_edge(fp: &Footprint, rect: &Rect, side: EdgeSide, coef: f32) -> Option<EdgeEstimate> {
+pub fn solve_edge(
+    fp: &Footprint,
+    rect: &Rect,
+    side: EdgeSide,
+    coef: f32,
+    min_band: f32,
+) -> Option<EdgeEstimate> {
     if coef.is_nan() || coef <= 0.0 {
         return None;
     }
@@ -100,7 +108,7 @@ pub fn solve_edge(fp: &Footprint, rect: &Rect, side: EdgeSide, coef: f32) -> Opt
     let x = solution?;
     // Slope from the samples within delta of the solution: the weight per unit length there.
     let size = if along_u { rect.width() } else { rect.height() };
-    let delta = (0.05 * size).max(1e-3);
+    let delta = (0.05 * size).max(min_band);
     let band: f32 = relevant
         .iter()
         .filter(|(q, _)| (q - x).abs() <= delta)
@@ -129,7 +137,8 @@ pub fn combine(estimates: &[EdgeEstimate]) -> Option<f32> {
             .iter()
             .map(|e| ((e.position - median).abs(), e.weight)),
     )?;
-    let limit = 4.0 * mad.max(1e-6);
+    // All but a few solutions equal (a MAD of 0): keep those within rounding of the median.
+    let limit = 4.0 * mad.max(f32::EPSILON * median.abs());
     let (sum, wsum) = usable
         .iter()
         .filter(|e| (e.position - median).abs() <= limit)

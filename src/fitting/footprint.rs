@@ -196,11 +196,12 @@ pub fn footprint_with(
             continue;
         };
         // A ray that cannot reach the plane cannot land on it: no need to trace it, and one
-        // that can need not look beyond it.
+        // that can need not look beyond it (a thousandth further: the face's triangles lie
+        // within a ten-thousandth of the distance of its plane).
         let Some(t_plane) = plane.distance(start, sample.wi) else {
             continue;
         };
-        if let Some(hit) = first_surface(scene, start, sample.wi, tmin, t_plane * 1.001 + 1e-3) {
+        if let Some(hit) = first_surface(scene, start, sample.wi, tmin, t_plane * 1.001) {
             if plane.contains_triangle(scene, hit.triangle) {
                 fp.points.push(plane.coords(start + sample.wi * hit.t));
                 fp.weights.push(sample.weight);

@@ -122,8 +122,22 @@ impl LightPlane {
     /// True when two planes are the same face (for merging fragments).
     pub fn same_face(&self, other: &LightPlane) -> bool {
         (self.node, self.mesh, self.primitive) == (other.node, other.mesh, other.primitive)
-            && self.normal.dot(other.normal) > 1.0 - COPLANAR_COS
-            && (other.point - self.point).dot(self.normal).abs() < plane_tolerance(self.point)
+            && self.same_plane(other)
+    }
+
+    /// True when two planes are one plane, whatever faces they came from: parallel, and
+    /// each point within [`plane_tolerance`] of the other plane.
+    pub fn same_plane(&self, other: &LightPlane) -> bool {
+        self.normal.dot(other.normal) > 1.0 - COPLANAR_COS
+            && (other.point - self.point).dot(self.normal).abs()
+                <= plane_tolerance(self.point, other.point)
+    }
+
+    /// The distance from the camera to the plane's origin (the scene frame is centred on the
+    /// camera): the length every tolerance of the fit on this plane is a share of, so that a
+    /// scene scaled as a whole is fitted as it is unscaled.
+    pub fn camera_distance(&self) -> f32 {
+        self.point.length()
     }
 }
 
@@ -131,16 +145,19 @@ impl LightPlane {
 /// tessellated flat wall exported in f32 stays far inside it, a bent one does not).
 const COPLANAR_COS: f32 = 3e-4;
 
-/// Distance within which a point lies on a plane: f32 rounding of coordinates of size `p`.
-fn plane_tolerance(p: Vec3) -> f32 {
-    1e-4 * (1.0 + p.abs().max_element())
+/// Distance within which points `a` and `b` (scene frame, centred on the camera) lie on one
+/// plane: a share of their distance from the camera, far above f32 rounding there (a 1e-4
+/// share is about 1700 units in the last place) and far below any real step between two
+/// walls.
+fn plane_tolerance(a: Vec3, b: Vec3) -> f32 {
+    1e-4 * a.abs().max_element().max(b.abs().max_element())
 }
 
 fn coplanar(tri: [Vec3; 3], tri_normal: Vec3, point: Vec3, normal: Vec3) -> bool {
     tri_normal.dot(normal).abs() > 1.0 - COPLANAR_COS
         && tri
             .iter()
-            .all(|&c| (c - point).dot(normal).abs() < plane_tolerance(c))
+            .all(|&c| (c - point).dot(normal).abs() <= plane_tolerance(c, point))
 }
 
 /// A face found by the lobe's rays, while counting.

@@ -333,37 +333,13 @@ pub fn fit_paper_with(
         }
     }
     let mut times = single::StageTimes::default();
-    let mut skipped = Vec::new();
-    let mut warnings = Vec::new();
     let t = Instant::now();
-    // Which fragments belong together is decided on a coarse fit (an eighth of the samples:
-    // plenty to see whether two rectangles overlap), so that merged streaks are traced in
-    // full only once.
-    let groups: Vec<(StreakObservation, Vec<usize>)> = if streaks.len() > 1 {
-        let coarse = FitOptions {
-            samples: (options.samples / 8).max(32),
-            ..*options
-        };
-        let mut scratch = single::StageTimes::default();
-        let mut fitted: Vec<(StreakObservation, FittedLight)> = Vec::new();
-        for obs in streaks {
-            match single::fit_streak(water_model, scene, photo, water, obs, &coarse, &mut scratch) {
-                Ok(light) => fitted.push((obs.clone(), light)),
-                Err(s) => skipped.push(s),
-            }
-        }
-        merge_fragments(
-            water_model,
-            scene,
-            photo,
-            water,
-            &coarse,
-            fitted,
-            &mut warnings,
-        )
-    } else {
-        streaks.iter().map(|s| (s.clone(), vec![s.id])).collect()
-    };
+    let fragments::Grouping {
+        groups,
+        mut skipped,
+        mut warnings,
+        ..
+    } = fragments::group(water_model, scene, photo, water, streaks, options);
     let fragments_seconds = t.elapsed().as_secs_f64();
     let mut lights = Vec::new();
     for (obs, ids) in &groups {
@@ -396,57 +372,4 @@ pub fn fit_paper_with(
             ("fragments (coarse fit and merge)".into(), fragments_seconds),
         ],
     })
-}
-
-/// Merges, until none is left, pairs of fitted fragments on one face whose rectangles
-/// overlap, refitting each union; returns the final groups' observations with the ids of the
-/// streaks in each.
-fn merge_fragments(
-    water_model: &dyn WaterModel,
-    scene: &Scene,
-    photo: &Photo,
-    water: &[bool],
-    options: &FitOptions,
-    mut fitted: Vec<(StreakObservation, FittedLight)>,
-    warnings: &mut Vec<String>,
-) -> Vec<(StreakObservation, Vec<usize>)> {
-    let mut scratch = single::StageTimes::default();
-    loop {
-        let lights: Vec<FittedLight> = fitted.iter().map(|f| f.1.clone()).collect();
-        let Some((i, j)) = fragments::overlapping_pair(&lights) else {
-            break;
-        };
-        let (obs_j, light_j) = fitted.remove(j);
-        let (obs_i, light_i) = fitted.remove(i);
-        let mut ids: Vec<usize> = light_i
-            .streak_ids
-            .iter()
-            .chain(&light_j.streak_ids)
-            .copied()
-            .collect();
-        ids.sort_unstable();
-        let refit = fragments::merge(&obs_i, &obs_j, photo).map(|m| {
-            let fit =
-                single::fit_streak(water_model, scene, photo, water, &m, options, &mut scratch);
-            (m, fit)
-        });
-        match refit {
-            Some((m, Ok(mut light))) => {
-                light.streak_ids = ids;
-                fitted.insert(i, (m, light));
-            }
-            _ => {
-                warnings.push(format!(
-                    "streaks {} and {} overlap on one face but their union could not be \
-                     fitted; kept streak {} alone",
-                    obs_i.id, obs_j.id, obs_i.id
-                ));
-                fitted.insert(i, (obs_i, light_i));
-            }
-        }
-    }
-    fitted
-        .into_iter()
-        .map(|(obs, light)| (obs, light.streak_ids))
-        .collect()
 }

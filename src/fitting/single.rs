@@ -29,6 +29,8 @@ pub struct StageTimes {
 const MAX_ITERATIONS: usize = 25;
 /// Stop when no edge moved by more than this fraction of the rectangle's size.
 const TOLERANCE: f32 = 5e-4;
+/// Half the smallest side of a first rectangle, as a share of the light's distance.
+const MIN_START_SHARE: f32 = 1e-4;
 /// Fewer valid edge pixels than this leave an edge unconstrained.
 const MIN_EDGE_PIXELS: usize = 3;
 /// An edge is flagged unconstrained when more than this fraction of its pixels sit where the
@@ -175,7 +177,8 @@ pub fn fit_streak(
         .map(|i| &fps[i])
         .collect();
 
-    let result = solve(photo, obs, &fps, &edges, &bright_fps, true).and_then(|fit| {
+    let scale = plane.camera_distance();
+    let result = solve(photo, obs, &fps, &edges, &bright_fps, scale, true).and_then(|fit| {
         if plausible(&fit) {
             Ok(fit)
         } else {
@@ -183,7 +186,7 @@ pub fn fit_streak(
             // the current rectangle can run away: a smaller rectangle needs a brighter light,
             // which makes the edges move in further. The paper's way, L from the brightest
             // pixels with the whole plane lit and held, always settles.
-            solve(photo, obs, &fps, &edges, &bright_fps, false)
+            solve(photo, obs, &fps, &edges, &bright_fps, scale, false)
         }
     });
     times.solve += t.elapsed().as_secs_f64();
@@ -215,20 +218,24 @@ struct Solution {
     converged: bool,
 }
 
-/// Alternates radiance and edges from an initial rectangle until they agree.
+/// Alternates radiance and edges from an initial rectangle until they agree. `scale` is the
+/// light's distance from the camera ([`super::LightPlane::camera_distance`]), which the
+/// smallest lengths are shares of.
+#[allow(clippy::too_many_arguments)]
 fn solve(
     photo: &Photo,
     obs: &StreakObservation,
     fps: &[Footprint],
     edges: &[EdgePixel],
     bright: &[&Footprint],
+    scale: f32,
     update_radiance: bool,
 ) -> Result<Solution, Skipped> {
     let no_solution = |what: &str| Skipped::NoSolution {
         streak: obs.id,
         message: format!("streak {}: {what}", obs.id),
     };
-    let mut rect = initial_rect(fps, edges)
+    let mut rect = initial_rect(fps, edges, scale)
         .ok_or_else(|| no_solution("no edge pixel's reflected rays reach the light's plane"))?;
     let initial_radiance = fit_radiance(photo, bright, None).ok_or_else(|| {
         no_solution("the brightest pixels' reflected rays miss the light's plane")
@@ -306,7 +313,7 @@ fn solve(
                 .filter_map(|e| {
                     let fp = &fps[e.footprint];
                     let coef = observed_coefficient(fp.observed(photo), radiance)?;
-                    solve_edge(fp, &model, side, coef)
+                    solve_edge(fp, &model, side, coef, MIN_START_SHARE * scale)
                 })
                 .collect();
             if let Some(x) = combine(&estimates) {
@@ -355,7 +362,7 @@ fn plausible(fit: &Solution) -> bool {
     let peak = |l: [f32; 3]| l.iter().copied().fold(0.0f32, f32::max);
     let size = fit.rect.width().min(fit.rect.height());
     fit.converged
-        && size > 1e-3 * fit.rect.width().max(fit.rect.height()).max(1e-3)
+        && size > 1e-3 * fit.rect.width().max(fit.rect.height())
         && peak(fit.radiance) < 5.0 * peak(fit.initial_radiance)
 }
 
@@ -365,7 +372,7 @@ fn plausible(fit: &Solution) -> bool {
 /// light's bottom edge on the streak's top side). Edge pixels are dim, so their lobes are
 /// centred outside the light: the first pass sees every real edge pixel outside the rectangle,
 /// where the per-pixel assignment needs it.
-fn initial_rect(fps: &[Footprint], edges: &[EdgePixel]) -> Option<Rect> {
+fn initial_rect(fps: &[Footprint], edges: &[EdgePixel], scale: f32) -> Option<Rect> {
     let pct = |mut xs: Vec<f32>, q: f32| -> Option<f32> {
         if xs.is_empty() {
             return None;
@@ -406,8 +413,9 @@ fn initial_rect(fps: &[Footprint], edges: &[EdgePixel]) -> Option<Rect> {
     if r.v_min > r.v_max {
         (r.v_min, r.v_max) = (r.v_max, r.v_min);
     }
-    // A streak of one column still needs a rectangle with area to start from.
-    let min_size = 1e-3 * (1.0 + r.center().abs().max_element());
+    // A streak of one column still needs a rectangle with area to start from: a millimetre
+    // at ten metres.
+    let min_size = MIN_START_SHARE * scale;
     if r.width() < min_size {
         let c = r.center().x;
         (r.u_min, r.u_max) = (c - min_size, c + min_size);

@@ -7,12 +7,14 @@
 //! Streaks are numbered from left to right (by the centre of their bounding box), so that the
 //! lights a later step fits from them come out in an order a person can match with the photo.
 //!
-//! Fragments are not merged here: two fragments of one light (a wave breaking a streak) are
-//! told apart from two lights only by where their lights land in the scene, which the fitter
-//! knows (method §5 step 5).
+//! Fragments are not merged by the extraction: two fragments of one light (a wave breaking a
+//! streak) are told apart from two lights only by where their lights land in the scene, which
+//! the fitter knows (method §5 step 5, [`crate::fitting::fragments::group`]);
+//! [`Segmentation::merged`] then makes each group one streak ([`merge`]).
 
 pub mod edges;
 pub mod growing;
+mod merge;
 pub mod pictures;
 pub mod report;
 pub mod seeds;
@@ -78,6 +80,9 @@ pub struct Streak {
     pub mean_colour: [f32; 3],
     /// Its edge pixels by side (indexed by [`StreakSide`]), in raster order.
     pub edges: StreakEdges,
+    /// The streaks of the extraction it is made of, by their ids there: its own id alone
+    /// unless fragments were merged ([`Segmentation::merged`]).
+    pub fragments: Vec<usize>,
 }
 
 /// Everything the extraction found, stage by stage.
@@ -204,17 +209,9 @@ pub fn extract_streaks(
         .into_iter()
         .map(|sps| assemble(photo, sps, &water_members, &mean_luminance))
         .collect();
-    streaks.sort_by_key(|s| (s.bbox.x_min + s.bbox.x_max, s.bbox.y_min + s.bbox.y_max));
-    let mut owner = vec![u32::MAX; n];
-    for (id, s) in streaks.iter_mut().enumerate() {
-        s.id = id;
-        for &p in &s.pixels {
-            owner[p as usize] = id as u32;
-        }
-    }
+    number(&mut streaks, w, h);
     for s in streaks.iter_mut() {
-        let id = s.id as u32;
-        s.edges = edges::streak_edges(w, h, &s.pixels, |x, y| owner[(y * w + x) as usize] == id);
+        s.fragments = vec![s.id];
     }
     let max_water_value = value
         .iter()
@@ -236,6 +233,56 @@ pub fn extract_streaks(
     })
 }
 
+/// Numbers streaks left to right (by the centre of their bounding box) and finds their edges.
+fn number(streaks: &mut [Streak], w: u32, h: u32) {
+    streaks.sort_by_key(|s| (s.bbox.x_min + s.bbox.x_max, s.bbox.y_min + s.bbox.y_max));
+    let mut owner = vec![u32::MAX; w as usize * h as usize];
+    for (id, s) in streaks.iter_mut().enumerate() {
+        s.id = id;
+        for &p in &s.pixels {
+            owner[p as usize] = id as u32;
+        }
+    }
+    for s in streaks.iter_mut() {
+        let id = s.id as u32;
+        s.edges = edges::streak_edges(w, h, &s.pixels, |x, y| owner[(y * w + x) as usize] == id);
+    }
+}
+
+/// Of two pixels (indices into `radiance`), the one of greater luminance; `a` on a tie.
+pub fn brighter(radiance: &[[f32; 3]], a: u32, b: u32) -> u32 {
+    let lum = |p: u32| radiance.get(p as usize).map_or(0.0, |&c| luminance(c));
+    if lum(a) >= lum(b) {
+        a
+    } else {
+        b
+    }
+}
+
+/// The box around `pixels` and their mean linear radiance.
+fn box_and_mean(photo: &Photo, pixels: &[u32]) -> (BoundingBox, [f32; 3]) {
+    let w = photo.width;
+    let mut bbox = BoundingBox {
+        x_min: u32::MAX,
+        y_min: u32::MAX,
+        x_max: 0,
+        y_max: 0,
+    };
+    let mut sum = [0.0f64; 3];
+    for &p in pixels {
+        let (x, y) = (p % w, p / w);
+        bbox.x_min = bbox.x_min.min(x);
+        bbox.x_max = bbox.x_max.max(x);
+        bbox.y_min = bbox.y_min.min(y);
+        bbox.y_max = bbox.y_max.max(y);
+        for (c, s) in sum.iter_mut().enumerate() {
+            *s += photo.radiance[p as usize][c] as f64;
+        }
+    }
+    let k = pixels.len().max(1) as f64;
+    (bbox, sum.map(|s| (s / k) as f32))
+}
+
 /// Builds a streak (without id and edges) from its superpixels.
 fn assemble(
     photo: &Photo,
@@ -249,25 +296,7 @@ fn assemble(
         .flat_map(|&s| water_members[s as usize].iter().copied())
         .collect();
     pixels.sort_unstable();
-    let mut bbox = BoundingBox {
-        x_min: u32::MAX,
-        y_min: u32::MAX,
-        x_max: 0,
-        y_max: 0,
-    };
-    let mut sum = [0.0f64; 3];
-    for &p in &pixels {
-        let (x, y) = (p % w, p / w);
-        bbox.x_min = bbox.x_min.min(x);
-        bbox.x_max = bbox.x_max.max(x);
-        bbox.y_min = bbox.y_min.min(y);
-        bbox.y_max = bbox.y_max.max(y);
-        for (c, s) in sum.iter_mut().enumerate() {
-            *s += photo.radiance[p as usize][c] as f64;
-        }
-    }
-    let k = pixels.len().max(1) as f64;
-    let mean_colour = sum.map(|s| (s / k) as f32);
+    let (bbox, mean_colour) = box_and_mean(photo, &pixels);
     // Ties go to the first superpixel and the first pixel in raster order.
     let brightest_sp = superpixels
         .iter()
@@ -300,5 +329,6 @@ fn assemble(
         brightest: (brightest_pixel % w, brightest_pixel / w),
         mean_colour,
         edges: StreakEdges::default(),
+        fragments: Vec::new(),
     }
 }

@@ -24,8 +24,12 @@ pub struct Report {
     pub seed_count: usize,
     /// Number of seed superpixels.
     pub seed_superpixel_count: usize,
-    /// One entry per streak, left to right.
+    /// One entry per streak, left to right: per light, fragments of one light merged.
     pub streaks: Vec<StreakEntry>,
+    /// The streaks as the extraction found them, before fragments were merged (the same as
+    /// `streaks` when none were), numbered as `fragments` and the fit's `streak_ids` give
+    /// them.
+    pub fragments: Vec<StreakEntry>,
 }
 
 /// Width and height in pixels.
@@ -75,6 +79,8 @@ pub struct StreakEntry {
     pub mean_colour: [f32; 3],
     /// Edge pixel counts per side.
     pub edge_pixel_counts: EdgeCounts,
+    /// The ids (in the report's `fragments`) of the streaks of the extraction it is made of.
+    pub fragments: Vec<usize>,
 }
 
 /// A bounding box in pixels.
@@ -123,11 +129,37 @@ pub struct EdgeCounts {
     pub bottom: usize,
 }
 
-/// Builds the report of a segmentation.
-pub fn report(seg: &Segmentation, params: &StreakParams) -> Report {
+/// The entries of `seg`'s streaks.
+fn entries(seg: &Segmentation) -> Vec<StreakEntry> {
+    seg.streaks
+        .iter()
+        .map(|s| StreakEntry {
+            id: s.id,
+            pixel_count: s.pixels.len(),
+            superpixel_count: s.superpixels.len(),
+            bbox: s.bbox.into(),
+            brightest: Pixel {
+                x: s.brightest.0,
+                y: s.brightest.1,
+            },
+            mean_colour: s.mean_colour,
+            edge_pixel_counts: EdgeCounts {
+                left: s.edges[StreakSide::Left].len(),
+                right: s.edges[StreakSide::Right].len(),
+                top: s.edges[StreakSide::Top].len(),
+                bottom: s.edges[StreakSide::Bottom].len(),
+            },
+            fragments: s.fragments.clone(),
+        })
+        .collect()
+}
+
+/// Builds the report of a segmentation; `pieces` is the extraction `seg` was merged from
+/// ([`Segmentation::merged`]), `None` when `seg` is the extraction itself.
+pub fn report(seg: &Segmentation, pieces: Option<&Segmentation>, params: &StreakParams) -> Report {
     let n = seg.width as usize * seg.height as usize;
     Report {
-        format_version: 1,
+        format_version: 2,
         photo: PhotoSize {
             width: seg.width,
             height: seg.height,
@@ -145,33 +177,19 @@ pub fn report(seg: &Segmentation, params: &StreakParams) -> Report {
         superpixel_count: seg.superpixels.count,
         seed_count: seg.seeds.len(),
         seed_superpixel_count: seg.seed_superpixels.len(),
-        streaks: seg
-            .streaks
-            .iter()
-            .map(|s| StreakEntry {
-                id: s.id,
-                pixel_count: s.pixels.len(),
-                superpixel_count: s.superpixels.len(),
-                bbox: s.bbox.into(),
-                brightest: Pixel {
-                    x: s.brightest.0,
-                    y: s.brightest.1,
-                },
-                mean_colour: s.mean_colour,
-                edge_pixel_counts: EdgeCounts {
-                    left: s.edges[StreakSide::Left].len(),
-                    right: s.edges[StreakSide::Right].len(),
-                    top: s.edges[StreakSide::Top].len(),
-                    bottom: s.edges[StreakSide::Bottom].len(),
-                },
-            })
-            .collect(),
+        streaks: entries(seg),
+        fragments: entries(pieces.unwrap_or(seg)),
     }
 }
 
-/// Writes `streaks.json` to `path`.
-pub fn write_report(path: &Path, seg: &Segmentation, params: &StreakParams) -> Result<()> {
-    let mut bytes = serde_json::to_vec_pretty(&report(seg, params))
+/// Writes `streaks.json` to `path` (`pieces` as for [`report`]).
+pub fn write_report(
+    path: &Path,
+    seg: &Segmentation,
+    pieces: Option<&Segmentation>,
+    params: &StreakParams,
+) -> Result<()> {
+    let mut bytes = serde_json::to_vec_pretty(&report(seg, pieces, params))
         .map_err(|e| Error::output(path, format!("cannot write JSON: {e}")))?;
     bytes.push(b'\n');
     write_atomically(path, &bytes)

@@ -5,7 +5,7 @@
 //! samples ([`Problem::edge_profile`]), with that light's radiance re-optimised in closed form
 //! at every grid point, so a far-off start (the paper's estimate can be metres off) is pulled
 //! in by a global 1-D search rather than a local step. The grid then shrinks around the best
-//! position until it is finer than a millimetre. An edge that no pixel of the streak's edge
+//! position until it is finer than a ten-thousandth of the light's size. An edge that no pixel of the streak's edge
 //! looks at (outside the photo) is held where the paper method put it.
 
 use glam::Vec2;
@@ -16,10 +16,11 @@ use crate::fitting::EdgeSide;
 
 /// Grid points of an edge profile.
 const GRID: usize = 65;
-/// Smallest search half-window, metres: its grid's step (1/32 of it) is far under the 0.5 %
-/// of a metre-sized light asked for. 1 mm rather than 0.2 mm: three sweeps fewer on Table
-/// 3, the same errors over 8 seeds (BENCHMARKS.md).
-const MIN_WINDOW: f32 = 1e-3;
+/// Smallest search half-window, as a share of the light's larger side at the descent's start
+/// (1 mm for the 3 m light of Table 1): its grid's step (1/32 of it) is far under the 0.5 %
+/// of the light's size asked for. 1 mm rather than 0.2 mm: three sweeps fewer on Table 3,
+/// the same errors over 8 seeds (BENCHMARKS.md).
+const MIN_WINDOW_SHARE: f32 = 1.0 / 3000.0;
 /// Factor by which an edge's search window shrinks per sweep (unless the edge is still
 /// travelling). The new window keeps 8 of the old grid's steps either side of the best
 /// point, and the cost is smooth on that scale (see [`super::kernel`]): halving instead
@@ -27,9 +28,20 @@ const MIN_WINDOW: f32 = 1e-3;
 const WINDOW_SHRINK: f32 = 0.25;
 
 /// Half-width of the first search window around a start edge: half the light's size, at
-/// least 0.5 m, so that an estimate a light's size off is still inside the first grid.
-pub(super) fn first_window(r: &Rect) -> f32 {
-    (0.5 * r.width().max(r.height())).max(0.5)
+/// least [`FIRST_WINDOW_SHARE`] of its `distance` from the camera, so that an estimate a
+/// light's size off is still inside the first grid.
+pub(super) fn first_window(r: &Rect, distance: f32) -> f32 {
+    (0.5 * r.width().max(r.height())).max(FIRST_WINDOW_SHARE * distance)
+}
+
+/// The least first window, as a share of the light's distance from the camera: 0.5 m at the
+/// harbour's 40 m (at the paper's 10 m, 12.5 cm: no light of its samples is that small).
+const FIRST_WINDOW_SHARE: f32 = 0.0125;
+
+/// The smallest search half-window of a light whose rectangle is `r`: see
+/// [`MIN_WINDOW_SHARE`].
+fn min_window(r: &Rect) -> f32 {
+    MIN_WINDOW_SHARE * r.width().max(r.height())
 }
 
 impl Problem {
@@ -37,7 +49,13 @@ impl Problem {
     /// sweeps, stopping early once every search window has shrunk to its minimum.
     pub(super) fn descend(&self, st: &mut State, extents: &[Option<Rect>], sweeps: u32) {
         // Initial half-windows: see `first_window`.
-        let mut windows: Vec<[f32; 4]> = st.rects.iter().map(|r| [first_window(r); 4]).collect();
+        let mut windows: Vec<[f32; 4]> = st
+            .rects
+            .iter()
+            .zip(&st.set_of)
+            .map(|(r, &set)| [first_window(r, self.planes[set].distance); 4])
+            .collect();
+        let min_windows: Vec<f32> = st.rects.iter().map(min_window).collect();
         let grid = GRID;
         for _sweep in 0..sweeps {
             for k in 0..st.rects.len() {
@@ -52,11 +70,11 @@ impl Problem {
                     let half = windows[k][side];
                     let cur = st.rects[k].edge(side);
                     let min_size = self.planes[st.set_of[k]].min_size;
-                    let (lo, hi) = edge_bounds(&st.rects[k], side, &ext, min_size);
+                    let (lo, hi) = edge_bounds(&st.rects[k], side, &ext, min_size, min_windows[k]);
                     let a = (cur - half).max(lo);
                     let b = (cur + half).min(hi);
                     if b <= a {
-                        windows[k][side] = MIN_WINDOW;
+                        windows[k][side] = min_windows[k];
                         continue;
                     }
                     let step = (b - a) / (grid - 1) as f32;
@@ -85,21 +103,25 @@ impl Problem {
                     windows[k][side] = (half * WINDOW_SHRINK)
                         .max(4.0 * moved)
                         .min(half)
-                        .max(MIN_WINDOW);
+                        .max(min_windows[k]);
                 }
             }
             self.solve_radiance(st);
-            if windows.iter().flatten().all(|&w| w <= MIN_WINDOW) {
+            if windows
+                .iter()
+                .zip(&min_windows)
+                .all(|(w, &least)| w.iter().all(|&w| w <= least))
+            {
                 break;
             }
         }
     }
 }
 
-/// Where an edge may go: inside the samples' extent (with a millimetre to spare) and no
-/// nearer the opposite edge than `min_size` ([`super::samples::smallest_light`]).
-fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect, min_size: Vec2) -> (f32, f32) {
-    let eps = 1e-3;
+/// Where an edge may go: inside the samples' extent (with `eps`, the smallest window, to
+/// spare) and no nearer the opposite edge than `min_size`
+/// ([`super::samples::smallest_light`]).
+fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect, min_size: Vec2, eps: f32) -> (f32, f32) {
     match side {
         EdgeSide::Left => (ext.u_min - eps, r.u_max - min_size.x),
         EdgeSide::Right => (r.u_min + min_size.x, ext.u_max + eps),

@@ -56,7 +56,7 @@ struct DirectImage {
 }
 
 /// The starts moved onto their direct images and merged where they meet (module doc).
-pub(super) fn direct_starts(
+pub(crate) fn direct_starts(
     scene: &Scene,
     photo: &Photo,
     water: &[bool],
@@ -81,7 +81,7 @@ pub(super) fn direct_starts(
         };
         let same_image = on_image.iter().position(|&o| o == Some(im.first_pixel));
         match same_image {
-            Some(k) if same_plane(&out[k], light) => {
+            Some(k) if out[k].plane.same_plane(&light.plane) => {
                 out[k].streak_ids.extend(light.streak_ids.iter().copied());
             }
             _ => {
@@ -100,7 +100,9 @@ pub(super) fn direct_starts(
     let mut k = 0;
     while k < out.len() {
         let twin = (0..k).find(|&j| {
-            on_image[j].is_some() && on_image[j] == on_image[k] && same_plane(&out[j], &out[k])
+            on_image[j].is_some()
+                && on_image[j] == on_image[k]
+                && out[j].plane.same_plane(&out[k].plane)
         });
         if let Some(j) = twin {
             let ids = out[k].streak_ids.clone();
@@ -130,12 +132,6 @@ fn trimmed(light: &FittedLight, image: &Rect) -> FittedLight {
     out.v_min = light.v_min.max(image.v_min);
     out.v_max = light.v_max.min(image.v_max);
     out
-}
-
-/// Whether two lights lie on one plane (their planes' normals and offsets agree).
-fn same_plane(a: &FittedLight, b: &FittedLight) -> bool {
-    let (pa, pb) = (&a.plane, &b.plane);
-    pa.normal.dot(pb.normal) > 0.999 && (pb.point - pa.point).dot(pa.normal).abs() < 1e-3
 }
 
 /// Intersection over union of two rectangles (0 when either is empty).

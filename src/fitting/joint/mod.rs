@@ -96,7 +96,7 @@ mod control_variate;
 mod cost;
 mod descent;
 mod direct;
-mod direct_start;
+pub(crate) mod direct_start;
 #[cfg(test)]
 mod fixture;
 mod kernel;
@@ -319,10 +319,7 @@ pub fn fit_joint_with(
     }
     let t0 = Instant::now();
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
-    let roi: Vec<Rect> = start
-        .iter()
-        .map(|l| region_of_interest(&l.rect()))
-        .collect();
+    let roi: Vec<Rect> = start.iter().map(region_of_interest).collect();
     let probe_model = ReflectionModel {
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model

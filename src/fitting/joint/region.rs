@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use super::descent::first_window;
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
-use crate::fitting::StreakObservation;
+use crate::fitting::{FittedLight, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
@@ -134,6 +134,7 @@ fn sees_region_of_interest(
 
 /// Where on its plane a light's edges may go during the fit: the start rectangle grown by
 /// the first search window and a little more. Samples landing outside it are never traced.
-pub(super) fn region_of_interest(start: &Rect) -> Rect {
-    start.grow(1.25 * first_window(start))
+pub(super) fn region_of_interest(start: &FittedLight) -> Rect {
+    let rect = start.rect();
+    rect.grow(1.25 * first_window(&rect, start.plane.camera_distance()))
 }

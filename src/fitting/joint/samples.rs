@@ -60,6 +60,9 @@ pub(super) struct PlaneSamples {
     pub(super) gauss: Vec<LobeGaussian>,
     /// The smallest width and height a light on this plane may take ([`smallest_light`]).
     pub(super) min_size: Vec2,
+    /// The plane's distance from the camera ([`LightPlane::camera_distance`]): the length
+    /// the fit's smallest steps on this plane are shares of.
+    pub(super) distance: f32,
 }
 
 impl PlaneSamples {
@@ -253,7 +256,9 @@ pub(super) fn trace_samples(
                     let Some(reach) = reach else {
                         continue;
                     };
-                    let tmax = reach * 1.001 + 1e-3;
+                    // A thousandth further: a face's triangles lie within a ten-thousandth
+                    // of the distance of its plane.
+                    let tmax = reach * 1.001;
                     let hit = scene
                         .tracer
                         .closest_hit(water.start, s.wi, water.tmin(s.wi), tmax);
@@ -323,6 +328,7 @@ pub(super) fn trace_samples(
                 halves: Vec::new(),
                 gauss: Vec::with_capacity(pixels.len()),
                 min_size: Vec2::ZERO,
+                distance: planes[k].camera_distance(),
             };
             out.offsets.push(0);
             for (hits, gauss) in &per_pixel {
@@ -345,7 +351,7 @@ pub(super) fn trace_samples(
             }
             // From the water pixels' samples alone: the bound is about the lobes' kernels.
             let lobe_samples = out.offsets[first_direct.min(pixels.len())] as usize;
-            out.min_size = smallest_light(&out.cells[..lobe_samples]);
+            out.min_size = smallest_light(&out.cells[..lobe_samples], out.distance);
             out
         })
         .collect();
@@ -361,8 +367,9 @@ fn shuffle(items: &mut [u32], rng: &mut Rng) {
 }
 
 /// The smallest width and height of a light whose samples' kernels have the half-widths
-/// `cells`: twice the median half-width along each axis, the kernels' typical full width (a
-/// few millimetres when the cells are points). A narrower rectangle is seen only through the
+/// `cells`: twice the median half-width along each axis, the kernels' typical full width (at
+/// least [`SMALLEST_LIGHT_SHARE`] of the plane's `distance` from the camera, when the cells
+/// are points). A narrower rectangle is seen only through the
 /// kernels' shape (its coefficient is the kernels' density where it lies, negative lobes
 /// included, from the few samples near it), so its coefficients are noise out of all
 /// proportion to their size, and the fit, which subtracts the estimated noise from its cost,
@@ -371,7 +378,7 @@ fn shuffle(items: &mut [u32], rng: &mut Rng) {
 /// thinner than its samples' kernels"). A real light narrower than the bound (a strip light) comes out this
 /// wide, with the radiance that keeps its reflection; more samples per pixel make the kernels,
 /// and the bound, smaller.
-pub(super) fn smallest_light(cells: &[Vec2]) -> Vec2 {
+pub(super) fn smallest_light(cells: &[Vec2], distance: f32) -> Vec2 {
     // Every 8th sample: a median needs no more, and a plane holds millions.
     let (mut xs, mut ys): (Vec<f32>, Vec<f32>) =
         cells.iter().step_by(8).map(|c| (c.x, c.y)).unzip();
@@ -382,8 +389,13 @@ pub(super) fn smallest_light(cells: &[Vec2]) -> Vec2 {
         let mid = v.len() / 2;
         *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
     };
-    Vec2::new(2.0 * median(&mut xs), 2.0 * median(&mut ys)).max(Vec2::splat(2e-3))
+    Vec2::new(2.0 * median(&mut xs), 2.0 * median(&mut ys))
+        .max(Vec2::splat(SMALLEST_LIGHT_SHARE * distance))
 }
+
+/// The smallest light's side when the kernels are points, as a share of its distance from
+/// the camera: 2 mm at 10 m.
+const SMALLEST_LIGHT_SHARE: f32 = 2e-4;
 
 /// How far the photo could possibly move an edge: the extent of light k's stored samples.
 pub(super) fn sample_extent(p: &PlaneSamples) -> Option<Rect> {

@@ -30,8 +30,8 @@ pub struct Uncertainty {
 /// its streak is seen); the full covariance carries them.
 ///
 /// An edge's derivative is the change of the coefficients over a step of 2 % of the light's
-/// size (at least 5 mm) each way: below a few millimetres the stored samples make the
-/// coefficients a staircase. A direct pixel's (`direct`) is taken over a quarter of its
+/// size (at least 5e-4 of its distance from the camera, 5 mm at 10 m) each way: below a few
+/// millimetres at that distance the stored samples make the coefficients a staircase. A direct pixel's (`direct`) is taken over a quarter of its
 /// footprint, and only the pixels that measure the model count ([`Problem::measures`]: not
 /// clipped, and not black where the light is seen directly). An edge that moves nothing gets no uncertainty (`None`: the photo
 /// does not constrain it), and so does a pinned one.
@@ -50,7 +50,8 @@ pub(super) fn uncertainties(
     let mut params: Vec<Param> = Vec::new();
     for k in 0..lights {
         let r = st.rects[k];
-        let h = (0.02 * r.width().max(r.height())).max(0.005);
+        let h =
+            (0.02 * r.width().max(r.height())).max(5e-4 * problem.planes[st.set_of[k]].distance);
         for side in EdgeSide::ALL {
             if st.pinned[k][side] || extents[st.set_of[k]].is_none() {
                 continue;
