@@ -171,33 +171,19 @@ fn the_gloss_and_the_lights_do_not_depend_on_the_start() {
                 }
                 // The edge's place in the world, against the nearer of the truth's two
                 // edges on that axis (the plane's u may run along -x).
-                let (got, edges, size) = match side {
-                    EdgeSide::Left | EdgeSide::Right => {
-                        let u = if side == EdgeSide::Left {
-                            light.u_min
-                        } else {
-                            light.u_max
-                        };
-                        let x = light.world_at(scene.origin, u, vm).x;
-                        (
-                            x,
-                            [truth.corner.x, truth.corner.x + truth.width],
-                            truth.width,
-                        )
-                    }
-                    EdgeSide::Bottom | EdgeSide::Top => {
-                        let v = if side == EdgeSide::Bottom {
-                            light.v_min
-                        } else {
-                            light.v_max
-                        };
-                        let y = light.world_at(scene.origin, um, v).y;
-                        (
-                            y,
-                            [truth.corner.y, truth.corner.y + truth.height],
-                            truth.height,
-                        )
-                    }
+                let (u, v) = match side {
+                    EdgeSide::Left => (light.u_min, vm),
+                    EdgeSide::Right => (light.u_max, vm),
+                    EdgeSide::Bottom => (um, light.v_min),
+                    EdgeSide::Top => (um, light.v_max),
+                };
+                let p = light.world_at(scene.origin, u, v);
+                let (got, edges, size) = if matches!(side, EdgeSide::Left | EdgeSide::Right) {
+                    let x = truth.corner.x;
+                    (p.x, [x, x + truth.width], truth.width)
+                } else {
+                    let y = truth.corner.y;
+                    (p.y, [y, y + truth.height], truth.height)
                 };
                 let error = edges
                     .iter()
