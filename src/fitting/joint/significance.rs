@@ -34,10 +34,12 @@ pub(super) fn shares(problem: &Problem, st: &State) -> Vec<f64> {
     let lights = st.rects.len();
     let mut own = vec![0.0; lights];
     let mut weighted = vec![0.0; lights];
+    let brightness: Vec<f64> = st.radiance.iter().map(|l| l.iter().sum()).collect();
+    let mut per = vec![0.0; lights];
     for i in 0..problem.first_direct {
-        let per: Vec<f64> = (0..lights)
-            .map(|k| st.coef[k][i].max(0.0) as f64 * st.radiance[k].iter().sum::<f64>())
-            .collect();
+        for k in 0..lights {
+            per[k] = st.coef[k][i].max(0.0) as f64 * brightness[k];
+        }
         let all: f64 = per.iter().sum();
         if all <= 0.0 {
             continue;
