@@ -210,9 +210,11 @@ pub fn fit(
     let thorough = found
         .reading
         .is_some_and(|r| r.all_pixels && r.samples >= THOROUGH.samples);
-    found
-        .warnings
-        .extend(warnings::shared_streak_warnings(&found.lights, thorough));
+    found.warnings.extend(warnings::shared_streak_warnings(
+        &found.lights,
+        &found.seen(),
+        thorough,
+    ));
     Ok(Lit {
         lights: found.lights,
         uncertainties: found.uncertainties,
@@ -240,6 +242,20 @@ struct Found {
     timings: Vec<(String, f64)>,
     /// The last joint fit's expected image (its fitted pixels and their modelled radiance).
     modelled: Vec<(u32, [f32; 3])>,
+}
+
+impl Found {
+    /// For each light, whether the photo shows the light itself (its uncertainty counts
+    /// direct pixels); false where no uncertainty was computed.
+    fn seen(&self) -> Vec<bool> {
+        (0..self.lights.len())
+            .map(|k| {
+                self.uncertainties
+                    .get(k)
+                    .is_some_and(|u| u.direct_pixels > 0)
+            })
+            .collect()
+    }
 }
 
 /// The inputs every fitting stage of one run shares.
@@ -342,7 +358,7 @@ impl Run<'_> {
         let Some(reading) = j.overlap_refit else {
             return Ok(());
         };
-        if !warnings::shares_a_streak(&found.lights) {
+        if !warnings::shares_a_streak(&found.lights, &found.seen()) {
             return Ok(());
         }
         self.progress.stage(&format!(

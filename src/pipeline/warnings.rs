@@ -1,7 +1,7 @@
 //! What the pipeline tells the user beyond the lights: why nothing was found, and a warning
 //! for lights whose reflections overlap.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
 use super::{light_name, Input, THOROUGH};
 use crate::fitting::{FittedLight, Skipped};
@@ -72,38 +72,51 @@ pub(super) fn nothing_found(
     )
 }
 
-/// Whether two of `lights` stand for the same streak (the joint fit split it).
-pub(super) fn shares_a_streak(lights: &[FittedLight]) -> bool {
-    let mut seen = BTreeSet::new();
-    lights
-        .iter()
-        .flat_map(|l| l.streak_ids.iter())
-        .any(|&id| !seen.insert(id))
+/// For each streak two or more of `lights` stand for (the joint fit split it, or one lamp's
+/// direct image started each), those lights, unless every one of them is seen in the photo
+/// itself (`seen`, by index): each lamp's direct image then pins its own light, and the photo
+/// tells them apart to a fraction of a pixel (an orange lamp under a blue one: edges within
+/// 0.03 %, radiances 0.6 %), where the reflections alone tell them apart only weakly.
+fn lights_by_shared_streak(lights: &[FittedLight], seen: &[bool]) -> BTreeMap<usize, Vec<usize>> {
+    let mut by_streak: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (k, light) in lights.iter().enumerate() {
+        for &streak in &light.streak_ids {
+            by_streak.entry(streak).or_default().push(k);
+        }
+    }
+    by_streak
+        .retain(|_, ks| ks.len() > 1 && !ks.iter().all(|&k| seen.get(k).copied().unwrap_or(false)));
+    by_streak
+}
+
+/// Whether two of `lights` stand for the same streak and the reflections alone must tell
+/// them apart ([`lights_by_shared_streak`]).
+pub(super) fn shares_a_streak(lights: &[FittedLight], seen: &[bool]) -> bool {
+    !lights_by_shared_streak(lights, seen).is_empty()
 }
 
 /// One warning per set of lights that share streaks (overlapping reflections, split by the
 /// joint fit; a light merged from two streaks and then split makes one warning naming both
-/// streaks): the photo tells such lights apart only weakly, so their facing edges and
+/// streaks) and that the reflections alone must tell apart ([`lights_by_shared_streak`]):
+/// the photo tells such lights apart only weakly, so their facing edges and
 /// radiances can be off by several percent (on the bundled stacked sample, even with the
 /// refit over every pixel, the facing edges are about 5 % rms off over 8 seeds and the upper
 /// light's radiance up to 14 %: BENCHMARKS.md, the spread bench). Their reported
 /// uncertainties are as wide; the warning says why. Unless the fit already read every pixel
 /// with at least [`THOROUGH`]'s samples (`thorough`), it also says how to fit such lights
 /// more closely. Lights are named by [`light_name`] of their index.
-pub(super) fn shared_streak_warnings(lights: &[FittedLight], thorough: bool) -> Vec<String> {
+pub(super) fn shared_streak_warnings(
+    lights: &[FittedLight],
+    seen: &[bool],
+    thorough: bool,
+) -> Vec<String> {
     let names: Vec<String> = (0..lights.len()).map(light_name).collect();
-    let mut by_streak: BTreeMap<usize, Vec<&str>> = BTreeMap::new();
-    for (light, name) in lights.iter().zip(&names) {
-        for &streak in &light.streak_ids {
-            by_streak.entry(streak).or_default().push(name);
-        }
-    }
+    let by_streak = lights_by_shared_streak(lights, seen);
     // Two streaks that one merged light spans make one warning, not one per streak.
     let mut by_lights: BTreeMap<Vec<&str>, Vec<usize>> = BTreeMap::new();
-    for (streak, names) in by_streak {
-        if names.len() > 1 {
-            by_lights.entry(names).or_default().push(streak);
-        }
+    for (streak, ks) in by_streak {
+        let names = ks.iter().map(|&k| names[k].as_str()).collect();
+        by_lights.entry(names).or_default().push(streak);
     }
     by_lights
         .into_iter()

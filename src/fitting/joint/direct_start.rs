@@ -21,11 +21,7 @@
 //! the brightest such pixel's largest channel); of their 8-connected groups in the image,
 //! the one whose centre on the plane is nearest the start's centre.
 
-use std::collections::VecDeque;
-
-use glam::Vec2;
-
-use super::direct::image_box;
+use super::direct_images::{images_in, DirectImage};
 use crate::fitting::rect::Rect;
 use crate::fitting::FittedLight;
 use crate::photo_in::Photo;
@@ -34,26 +30,6 @@ use crate::scene_in::Scene;
 /// A start overlapping its direct image by less than this (intersection over union) is
 /// moved onto it. Two stacked lamps' starts overlap their joint image by about a half.
 pub const REPLACE_OVERLAP: f32 = 0.25;
-
-/// Fewest pixels a direct image must have to move a start.
-const MIN_PIXELS: usize = 4;
-
-/// A bright group of direct pixels on a light's plane.
-struct DirectImage {
-    /// Its pixels' smallest index: the group's identity.
-    first_pixel: usize,
-    /// Its bounding rectangle on the plane, grown by half a pixel's footprint.
-    rect: Rect,
-    /// Whether every pixel around the group sees the plane (dark or dim): the light ends
-    /// where its image ends, on every side. False where the frame's border, the water or
-    /// anything in front of the wall cuts the image, which may then hide part of the light.
-    /// For the image chosen for a start: and so are all the others the start overlaps.
-    enclosed: bool,
-    /// For the image chosen for a start: the bounding rectangle of every image the start
-    /// overlaps, what the start is trimmed to (two stacked lamps are two images under one
-    /// start).
-    reach: Rect,
-}
 
 /// The starts moved onto their direct images and merged where they meet (module doc).
 pub(crate) fn direct_starts(
@@ -135,7 +111,7 @@ fn trimmed(light: &FittedLight, image: &Rect) -> FittedLight {
 }
 
 /// Intersection over union of two rectangles (0 when either is empty).
-fn overlap(a: &Rect, b: &Rect) -> f32 {
+pub(super) fn overlap(a: &Rect, b: &Rect) -> f32 {
     let w = (a.u_max.min(b.u_max) - a.u_min.max(b.u_min)).max(0.0);
     let h = (a.v_max.min(b.v_max) - a.v_min.max(b.v_min)).max(0.0);
     let inter = w * h;
@@ -156,103 +132,8 @@ fn direct_image(
 ) -> Option<DirectImage> {
     let start = light.rect();
     let search = start.grow(start.width().max(start.height()));
-    let plane = &light.plane;
-    let (w, h) = (photo.width, photo.height);
-    let (x0, y0, x1, y1) = image_box(scene, &[plane], &[search], w, h)?;
-    // The pixels of the box that see the plane inside the search rectangle: index, plane
-    // coordinates, distance from the camera, brightness.
-    let mut seen: Vec<(usize, Vec2, f32, f32)> = Vec::new();
-    let origin = scene.camera.position;
-    for y in y0..=y1 {
-        for x in x0..=x1 {
-            let i = photo.index(x, y);
-            if water[i] {
-                continue;
-            }
-            let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
-            let Some(hit) = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY) else {
-                continue;
-            };
-            if !plane.contains_triangle(scene, hit.triangle) {
-                continue;
-            }
-            let q = plane.coords(origin + dir * hit.t);
-            if !search.contains(q) {
-                continue;
-            }
-            let value = if photo.clipped[i] {
-                f32::INFINITY
-            } else {
-                photo.radiance[i].into_iter().fold(0.0f32, f32::max)
-            };
-            seen.push((i, q, hit.t, value));
-        }
-    }
-    let brightest = seen
-        .iter()
-        .map(|s| s.3)
-        .filter(|v| v.is_finite())
-        .fold(0.0f32, f32::max);
-    let any_clipped = seen.iter().any(|s| s.3.is_infinite());
-    if brightest <= 0.0 && !any_clipped {
-        return None;
-    }
-    let threshold = if any_clipped && brightest <= 0.0 {
-        f32::INFINITY
-    } else {
-        0.5 * brightest
-    };
-    let bright: Vec<&(usize, Vec2, f32, f32)> = seen.iter().filter(|s| s.3 >= threshold).collect();
-    let groups = groups_8(&bright.iter().map(|s| s.0).collect::<Vec<_>>(), w as usize);
-    let sees_plane: std::collections::HashSet<usize> = seen.iter().map(|s| s.0).collect();
-    // Every 8-neighbour of the group's pixels is in the frame and sees the plane.
-    let enclosed = |g: &[usize]| {
-        g.iter().all(|&m| {
-            let p = bright[m].0;
-            let (x, y) = ((p % w as usize) as i64, (p / w as usize) as i64);
-            (-1..=1i64).all(|dy| {
-                (-1..=1i64).all(|dx| {
-                    let (nx, ny) = (x + dx, y + dy);
-                    nx >= 0
-                        && ny >= 0
-                        && nx < w as i64
-                        && ny < h as i64
-                        && sees_plane.contains(&(ny as usize * w as usize + nx as usize))
-                })
-            })
-        })
-    };
-    // One pixel's footprint on the plane at distance t, across: t times the pixel's angle.
-    let pixel_angle = 2.0 * (scene.camera.yfov * 0.5).tan() / h as f32;
+    let images = images_in(scene, photo, water, &light.plane, search);
     let centre = start.center();
-    let images: Vec<DirectImage> = groups
-        .into_iter()
-        .filter(|g| g.len() >= MIN_PIXELS)
-        .map(|g| {
-            let mut rect = Rect {
-                u_min: f32::INFINITY,
-                u_max: f32::NEG_INFINITY,
-                v_min: f32::INFINITY,
-                v_max: f32::NEG_INFINITY,
-            };
-            let mut t_sum = 0.0;
-            for &m in &g {
-                let (_, q, t, _) = bright[m];
-                rect.u_min = rect.u_min.min(q.x);
-                rect.u_max = rect.u_max.max(q.x);
-                rect.v_min = rect.v_min.min(q.y);
-                rect.v_max = rect.v_max.max(q.y);
-                t_sum += t;
-            }
-            let half_pixel = 0.5 * pixel_angle * t_sum / g.len() as f32;
-            DirectImage {
-                first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
-                rect: rect.grow(half_pixel),
-                enclosed: enclosed(&g),
-                reach: rect.grow(half_pixel),
-            }
-        })
-        .collect();
     // What the start may be trimmed to: every image it overlaps (two stacked lamps the
     // reflections started as one light are two images), enclosed only if all of them are.
     let overlapped: Vec<&DirectImage> = images
@@ -280,45 +161,6 @@ fn direct_image(
             reach: reach.unwrap_or(im.rect),
             ..im
         })
-}
-
-/// The 8-connected groups of the image pixels `pixels` (indices into a row-major image of
-/// width `width`), each a list of positions in `pixels`.
-fn groups_8(pixels: &[usize], width: usize) -> Vec<Vec<usize>> {
-    let position: std::collections::HashMap<usize, usize> =
-        pixels.iter().enumerate().map(|(k, &p)| (p, k)).collect();
-    let mut group_of = vec![usize::MAX; pixels.len()];
-    let mut groups = Vec::new();
-    for k in 0..pixels.len() {
-        if group_of[k] != usize::MAX {
-            continue;
-        }
-        let id = groups.len();
-        let mut members = Vec::new();
-        let mut queue = VecDeque::from([k]);
-        group_of[k] = id;
-        while let Some(m) = queue.pop_front() {
-            members.push(m);
-            let (x, y) = ((pixels[m] % width) as i64, (pixels[m] / width) as i64);
-            for dy in -1..=1i64 {
-                for dx in -1..=1i64 {
-                    let (nx, ny) = (x + dx, y + dy);
-                    if (dx, dy) == (0, 0) || nx < 0 || ny < 0 || nx >= width as i64 {
-                        continue;
-                    }
-                    let p = ny as usize * width + nx as usize;
-                    if let Some(&n) = position.get(&p) {
-                        if group_of[n] == usize::MAX {
-                            group_of[n] = id;
-                            queue.push_back(n);
-                        }
-                    }
-                }
-            }
-        }
-        groups.push(members);
-    }
-    groups
 }
 
 #[cfg(test)]
@@ -469,16 +311,6 @@ mod tests {
         cut[row..row + photo.width as usize].fill(true);
         let out = direct_starts(&scene, &photo, &cut, &[light(&plane, tall, 0)]);
         assert_eq!(out[0].rect(), tall);
-    }
-
-    #[test]
-    fn groups_are_8_connected() {
-        // Width 5: (0,0),(1,1) touch diagonally; (4,0) is alone; (3,3),(4,3) touch.
-        let px = [0, 6, 4, 18, 19];
-        let mut g = groups_8(&px, 5);
-        g.iter_mut().for_each(|m| m.sort_unstable());
-        g.sort();
-        assert_eq!(g, vec![vec![0, 1], vec![2], vec![3, 4]]);
     }
 
     #[test]

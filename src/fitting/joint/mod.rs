@@ -48,7 +48,8 @@
 //! held where the paper method put it.
 //!
 //! Overlapping streaks (two lights whose reflections merge into one region, the paper's
-//! §5.3): when the residual of a fit is structured along the image rows, each light is tried
+//! §5.3): where the lamps are in the photo, each lamp's direct image starts a light of its
+//! own (`lamp_starts`). Otherwise, when the residual of a fit is structured along the image rows, each light is tried
 //! as two (one above the other, or side by side: `split`), and the split is kept when it
 //! removes most of that structure. The second light of a split then reads a sample set of
 //! its own, drawn independently on the same plane, and the boundary between the two is
@@ -62,7 +63,9 @@
 //! | `mod.rs` | options, outcome, [`fit_joint`] |
 //! | `region` | the fitted pixels, each light's region of interest |
 //! | `direct` | the pixels that see a light's wall directly, their samples |
+//! | `direct_images` | a lamp's image in the photo: the bright pixels that see its wall |
 //! | `direct_start` | starts far from a light's direct image moved onto it, fragments merged |
+//! | `lamp_starts` | one start per lamp whose reflections share a streak with another's |
 //! | `samples` | tracing and storing the plane samples, a coefficient from them |
 //! | `kernel` | each sample's cell and kernel |
 //! | `control_variate` | the lobe Gaussian |
@@ -96,10 +99,12 @@ mod control_variate;
 mod cost;
 mod descent;
 mod direct;
+mod direct_images;
 pub(crate) mod direct_start;
 #[cfg(test)]
 mod fixture;
 mod kernel;
+mod lamp_starts;
 mod optimise;
 mod problem;
 mod profile;
@@ -291,13 +296,22 @@ pub fn fit_joint_with(
     // Starts far from the lights' direct images are moved onto them (`direct_start`).
     let moved;
     let start = if options.direct_view {
-        moved = direct_start::direct_starts(scene, photo, water, start);
-        if moved.len() < start.len() {
+        let on_images = direct_start::direct_starts(scene, photo, water, start);
+        if on_images.len() < start.len() {
             options.progress.stage(&format!(
                 "joint fit: {} of {} start light(s) merged into another whose lamp's direct \
                  image they lay on",
-                start.len() - moved.len(),
+                start.len() - on_images.len(),
                 start.len()
+            ));
+        }
+        let before = on_images.len();
+        moved = lamp_starts::one_light_per_lamp(scene, photo, water, streaks, on_images);
+        if moved.len() > before {
+            options.progress.stage(&format!(
+                "joint fit: {} lamp(s) in the photo whose reflections share another light's \
+                 streak start a light of their own",
+                moved.len() - before
             ));
         }
         &moved[..]

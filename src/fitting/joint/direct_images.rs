@@ -1,0 +1,199 @@
+//! The lamps themselves in the photo: the bright groups of pixels off the water that see a
+//! light's plane (its direct images), which place a light on its wall to a pixel.
+//!
+//! A direct image: the pixels outside the water whose camera ray (through the pixel's centre)
+//! meets the plane first, within a search rectangle, and that are bright (clipped in some
+//! channel, or at least half the brightest such pixel's largest channel), grouped
+//! 8-connected in the image.
+
+use std::collections::VecDeque;
+
+use glam::Vec2;
+
+use super::direct::image_box;
+use crate::fitting::light_plane::LightPlane;
+use crate::fitting::rect::Rect;
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+
+/// Fewest pixels a direct image must have to count.
+const MIN_PIXELS: usize = 4;
+
+/// A bright group of direct pixels on a light's plane.
+pub(super) struct DirectImage {
+    /// Its pixels' smallest index: the group's identity.
+    pub(super) first_pixel: usize,
+    /// Its bounding rectangle on the plane, grown by half a pixel's footprint.
+    pub(super) rect: Rect,
+    /// Whether every pixel around the group sees the plane (dark or dim): the light ends
+    /// where its image ends, on every side. False where the frame's border, the water or
+    /// anything in front of the wall cuts the image, which may then hide part of the light.
+    /// For the image chosen for a start: and so are all the others the start overlaps.
+    pub(super) enclosed: bool,
+    /// For the image chosen for a start: the bounding rectangle of every image the start
+    /// overlaps, what the start is trimmed to (two stacked lamps are two images under one
+    /// start).
+    pub(super) reach: Rect,
+}
+
+/// The direct images on `plane` inside `search` (module doc), each with `reach` its own
+/// rectangle.
+pub(super) fn images_in(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    plane: &LightPlane,
+    search: Rect,
+) -> Vec<DirectImage> {
+    let (w, h) = (photo.width, photo.height);
+    let Some((x0, y0, x1, y1)) = image_box(scene, &[plane], &[search], w, h) else {
+        return Vec::new();
+    };
+    // The pixels of the box that see the plane inside the search rectangle: index, plane
+    // coordinates, distance from the camera, brightness.
+    let mut seen: Vec<(usize, Vec2, f32, f32)> = Vec::new();
+    let origin = scene.camera.position;
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let i = photo.index(x, y);
+            if water[i] {
+                continue;
+            }
+            let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
+            let Some(hit) = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY) else {
+                continue;
+            };
+            if !plane.contains_triangle(scene, hit.triangle) {
+                continue;
+            }
+            let q = plane.coords(origin + dir * hit.t);
+            if !search.contains(q) {
+                continue;
+            }
+            let value = if photo.clipped[i] {
+                f32::INFINITY
+            } else {
+                photo.radiance[i].into_iter().fold(0.0f32, f32::max)
+            };
+            seen.push((i, q, hit.t, value));
+        }
+    }
+    let brightest = seen
+        .iter()
+        .map(|s| s.3)
+        .filter(|v| v.is_finite())
+        .fold(0.0f32, f32::max);
+    let any_clipped = seen.iter().any(|s| s.3.is_infinite());
+    if brightest <= 0.0 && !any_clipped {
+        return Vec::new();
+    }
+    let threshold = if any_clipped && brightest <= 0.0 {
+        f32::INFINITY
+    } else {
+        0.5 * brightest
+    };
+    let bright: Vec<&(usize, Vec2, f32, f32)> = seen.iter().filter(|s| s.3 >= threshold).collect();
+    let groups = groups_8(&bright.iter().map(|s| s.0).collect::<Vec<_>>(), w as usize);
+    let sees_plane: std::collections::HashSet<usize> = seen.iter().map(|s| s.0).collect();
+    // Every 8-neighbour of the group's pixels is in the frame and sees the plane.
+    let enclosed = |g: &[usize]| {
+        g.iter().all(|&m| {
+            let p = bright[m].0;
+            let (x, y) = ((p % w as usize) as i64, (p / w as usize) as i64);
+            (-1..=1i64).all(|dy| {
+                (-1..=1i64).all(|dx| {
+                    let (nx, ny) = (x + dx, y + dy);
+                    nx >= 0
+                        && ny >= 0
+                        && nx < w as i64
+                        && ny < h as i64
+                        && sees_plane.contains(&(ny as usize * w as usize + nx as usize))
+                })
+            })
+        })
+    };
+    // One pixel's footprint on the plane at distance t, across: t times the pixel's angle.
+    let pixel_angle = 2.0 * (scene.camera.yfov * 0.5).tan() / h as f32;
+    groups
+        .into_iter()
+        .filter(|g| g.len() >= MIN_PIXELS)
+        .map(|g| {
+            let mut rect = Rect {
+                u_min: f32::INFINITY,
+                u_max: f32::NEG_INFINITY,
+                v_min: f32::INFINITY,
+                v_max: f32::NEG_INFINITY,
+            };
+            let mut t_sum = 0.0;
+            for &m in &g {
+                let (_, q, t, _) = bright[m];
+                rect.u_min = rect.u_min.min(q.x);
+                rect.u_max = rect.u_max.max(q.x);
+                rect.v_min = rect.v_min.min(q.y);
+                rect.v_max = rect.v_max.max(q.y);
+                t_sum += t;
+            }
+            let half_pixel = 0.5 * pixel_angle * t_sum / g.len() as f32;
+            DirectImage {
+                first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
+                rect: rect.grow(half_pixel),
+                enclosed: enclosed(&g),
+                reach: rect.grow(half_pixel),
+            }
+        })
+        .collect()
+}
+
+/// The 8-connected groups of the image pixels `pixels` (indices into a row-major image of
+/// width `width`), each a list of positions in `pixels`.
+fn groups_8(pixels: &[usize], width: usize) -> Vec<Vec<usize>> {
+    let position: std::collections::HashMap<usize, usize> =
+        pixels.iter().enumerate().map(|(k, &p)| (p, k)).collect();
+    let mut group_of = vec![usize::MAX; pixels.len()];
+    let mut groups = Vec::new();
+    for k in 0..pixels.len() {
+        if group_of[k] != usize::MAX {
+            continue;
+        }
+        let id = groups.len();
+        let mut members = Vec::new();
+        let mut queue = VecDeque::from([k]);
+        group_of[k] = id;
+        while let Some(m) = queue.pop_front() {
+            members.push(m);
+            let (x, y) = ((pixels[m] % width) as i64, (pixels[m] / width) as i64);
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if (dx, dy) == (0, 0) || nx < 0 || ny < 0 || nx >= width as i64 {
+                        continue;
+                    }
+                    let p = ny as usize * width + nx as usize;
+                    if let Some(&n) = position.get(&p) {
+                        if group_of[n] == usize::MAX {
+                            group_of[n] = id;
+                            queue.push_back(n);
+                        }
+                    }
+                }
+            }
+        }
+        groups.push(members);
+    }
+    groups
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn groups_are_8_connected() {
+        // Width 5: (0,0),(1,1) touch diagonally; (4,0) is alone; (3,3),(4,3) touch.
+        let px = [0, 6, 4, 18, 19];
+        let mut g = groups_8(&px, 5);
+        g.iter_mut().for_each(|m| m.sort_unstable());
+        g.sort();
+        assert_eq!(g, vec![vec![0, 1], vec![2], vec![3, 4]]);
+    }
+}

@@ -1,0 +1,221 @@
+//! One lamp, one light: starts for lamps the photo shows whose reflections share a streak.
+//!
+//! Two lamps one above the other on a wall (an orange one under a blue one, 1.5 m apart)
+//! reflect into one streak when the ripples stretch each reflection over the other's, and
+//! the paper's estimate starts one light per streak. The joint fit can split a light in two
+//! (`split`), but with the lamps in the photo their direct pixels hold the light on one of
+//! them: the dark wall between the lamps refuses a light across both, and a cut of one lamp's
+//! image in half is refused as well. The fit then gave one light for the two lamps, its
+//! radiance a mix of both colours.
+//!
+//! The photo says where each lamp is: a bright direct image on the light's wall
+//! ([`super::direct_images`]), enclosed by pixels that see the wall (a whole lamp, not one cut
+//! by the frame or by something in front of it). So, after [`super::direct_start`]:
+//!
+//! - a start over exactly two such images, each at least [`MIN_LAMP_SHARE`] of the box
+//!   around both, becomes two starts, one on each image, sharing its streaks (a lit sign's
+//!   letters, many small images, are left to one light);
+//! - an image near a light that no start overlaps starts a light of its own, sharing the
+//!   light's streaks, when it is the lamp of a reflection in them: its mirror image in the
+//!   water (mirrored in the horizontal plane of the water where the camera sees the streaks)
+//!   projects inside the streaks' bounding box in the image.
+//!
+//! A light whose start lies on a lamp's image that another light starts on (a fragment of the
+//! streak the paper's estimate started as its own light) is then merged into that light.
+//! The joint fit shares the streaks' pixels between the lights, each pinned by its own direct
+//! image.
+
+use glam::Vec3;
+
+use super::direct_images::{images_in, DirectImage};
+use super::direct_start::overlap;
+use crate::fitting::observation::StreakObservation;
+use crate::fitting::rect::Rect;
+use crate::fitting::FittedLight;
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+
+/// The smallest share of the box around two lamps' images that each must make for a start
+/// over both to become two: two stacked lamps make a third to a half each, a sign's letters
+/// far less.
+const MIN_LAMP_SHARE: f32 = 0.2;
+
+/// Most streak pixels whose camera rays find the water's height (evenly spread over the
+/// streaks).
+const HEIGHT_PROBES: usize = 32;
+
+/// How far outside the streaks' bounding box a mirror image may project, as a share of the
+/// photo's larger side: the ripples spread a reflection around its mirror image.
+const BOX_MARGIN: f32 = 0.02;
+
+/// A light overlapping a lamp's image by at least this (intersection over union) starts on
+/// that lamp.
+const ON_IMAGE: f32 = 0.5;
+
+/// The lights of `lights` split and added to one per lamp (module doc).
+pub(crate) fn one_light_per_lamp(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    lights: Vec<FittedLight>,
+) -> Vec<FittedLight> {
+    let near: Vec<Vec<DirectImage>> = lights
+        .iter()
+        .map(|light| {
+            let start = light.rect();
+            let search = start.grow(start.width().max(start.height()));
+            images_in(scene, photo, water, &light.plane, search)
+                .into_iter()
+                .filter(|im| im.enclosed)
+                .collect()
+        })
+        .collect();
+    let mut out = Vec::with_capacity(lights.len());
+    for (light, images) in lights.iter().zip(&near) {
+        match two_lamps(&light.rect(), images) {
+            Some([a, b]) => out.extend([on_image(light, a), on_image(light, b)]),
+            None => out.push(light.clone()),
+        }
+    }
+    for (light, images) in lights.iter().zip(&near) {
+        let pixels: Vec<u32> = streaks
+            .iter()
+            .filter(|s| light.streak_ids.contains(&s.id))
+            .flat_map(|s| s.pixels.iter().copied())
+            .collect();
+        let Some(height) = water_height(scene, photo, &pixels) else {
+            continue;
+        };
+        for image in images {
+            let taken = out
+                .iter()
+                .any(|l| l.plane.same_plane(&light.plane) && intersects(&l.rect(), &image.rect));
+            let centre = image.rect.center();
+            let lamp = light.plane.point_at(centre.x, centre.y);
+            if !taken && mirror_in_box(scene, photo, &pixels, lamp, height) {
+                out.push(on_image(light, image));
+            }
+        }
+    }
+    merge_fragments(out, near.iter().flatten())
+}
+
+/// `lights` with every light whose centre lies on a lamp's image that another light starts on
+/// (overlaps by at least [`ON_IMAGE`]) merged into that light: a fragment of the streak the
+/// paper's estimate started as a light of its own, on a lamp now taken.
+fn merge_fragments<'a>(
+    mut lights: Vec<FittedLight>,
+    images: impl Iterator<Item = &'a DirectImage>,
+) -> Vec<FittedLight> {
+    let images: Vec<&DirectImage> = images.collect();
+    let on = |l: &FittedLight, im: &DirectImage| overlap(&l.rect(), &im.rect) >= ON_IMAGE;
+    let mut k = 0;
+    while k < lights.len() {
+        let c = lights[k].rect().center();
+        let host = images
+            .iter()
+            .filter(|im| im.rect.contains(c) && !on(&lights[k], im))
+            .find_map(|im| {
+                (0..lights.len()).find(|&j| {
+                    j != k && lights[j].plane.same_plane(&lights[k].plane) && on(&lights[j], im)
+                })
+            });
+        match host {
+            Some(j) => {
+                let ids = lights[k].streak_ids.clone();
+                lights[j].streak_ids.extend(ids);
+                lights[j].streak_ids.sort_unstable();
+                lights[j].streak_ids.dedup();
+                lights.remove(k);
+            }
+            None => k += 1,
+        }
+    }
+    lights
+}
+
+/// The two images under `start` when it lies over exactly two that each make at least
+/// [`MIN_LAMP_SHARE`] of the box around both (module doc).
+fn two_lamps<'a>(start: &Rect, images: &'a [DirectImage]) -> Option<[&'a DirectImage; 2]> {
+    let under: Vec<&DirectImage> = images
+        .iter()
+        .filter(|im| intersects(start, &im.rect))
+        .collect();
+    let [a, b] = under[..] else {
+        return None;
+    };
+    let around = Rect {
+        u_min: a.rect.u_min.min(b.rect.u_min),
+        u_max: a.rect.u_max.max(b.rect.u_max),
+        v_min: a.rect.v_min.min(b.rect.v_min),
+        v_max: a.rect.v_max.max(b.rect.v_max),
+    };
+    let area = |r: &Rect| r.width() * r.height();
+    let big = |im: &DirectImage| area(&im.rect) >= MIN_LAMP_SHARE * area(&around);
+    (big(a) && big(b) && !intersects(&a.rect, &b.rect)).then_some([a, b])
+}
+
+/// `light` started on `image`'s rectangle.
+fn on_image(light: &FittedLight, image: &DirectImage) -> FittedLight {
+    let mut out = light.clone();
+    out.u_min = image.rect.u_min;
+    out.u_max = image.rect.u_max;
+    out.v_min = image.rect.v_min;
+    out.v_max = image.rect.v_max;
+    out
+}
+
+/// Whether two rectangles share any area.
+fn intersects(a: &Rect, b: &Rect) -> bool {
+    a.u_min < b.u_max && b.u_min < a.u_max && a.v_min < b.v_max && b.v_min < a.v_max
+}
+
+/// The median height (world y) where the camera rays through up to [`HEIGHT_PROBES`] of
+/// `pixels` meet the water first, or `None` when none does.
+fn water_height(scene: &Scene, photo: &Photo, pixels: &[u32]) -> Option<f32> {
+    let step = pixels.len().div_ceil(HEIGHT_PROBES).max(1);
+    let origin = scene.camera.position;
+    let mut heights: Vec<f32> = pixels
+        .iter()
+        .step_by(step)
+        .filter_map(|&p| {
+            let (x, y) = (p % photo.width, p / photo.width);
+            let dir =
+                scene
+                    .camera
+                    .direction(x as f32 + 0.5, y as f32 + 0.5, photo.width, photo.height);
+            let hit = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY)?;
+            let on_water = scene.is_water.get(hit.triangle as usize) == Some(&true);
+            on_water.then_some((origin + dir * hit.t).y)
+        })
+        .collect();
+    if heights.is_empty() {
+        return None;
+    }
+    heights.sort_by(f32::total_cmp);
+    Some(heights[heights.len() / 2])
+}
+
+/// Whether `lamp`'s mirror image in the horizontal plane at `height` projects inside the
+/// bounding box of `pixels`, grown by [`BOX_MARGIN`].
+fn mirror_in_box(scene: &Scene, photo: &Photo, pixels: &[u32], lamp: Vec3, height: f32) -> bool {
+    let mirrored = Vec3::new(lamp.x, 2.0 * height - lamp.y, lamp.z);
+    let Some((x, y)) = scene.camera.project(mirrored, photo.width, photo.height) else {
+        return false;
+    };
+    let margin = BOX_MARGIN * photo.width.max(photo.height) as f32;
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for &p in pixels {
+        let (px, py) = (p % photo.width, p / photo.width);
+        x0 = x0.min(px);
+        x1 = x1.max(px);
+        y0 = y0.min(py);
+        y1 = y1.max(py);
+    }
+    !pixels.is_empty()
+        && x >= x0 as f32 - margin
+        && x <= x1 as f32 + 1.0 + margin
+        && y >= y0 as f32 - margin
+        && y <= y1 as f32 + 1.0 + margin
+}
