@@ -3,67 +3,20 @@
 
 mod common;
 
-use common::pipeline::{convert_options, sample_scenes};
+use common::pipeline::{convert_options, sample_photo_path, sample_scenes};
 use streaklight::convert::convert;
 use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
 
-/// The orange lamp under the blue one: lower corner (-2, 1, 0), 3 x 1.5 m, radiance
-/// (20, 10, 2.5); upper corner (-2, 4, 0), 3 x 1.5 m, radiance (3, 7, 20). 1.5 m of dark wall
-/// between them; over the sample's water (e = 500) their reflections make one streak.
-fn orange_and_blue() -> [SampleLight; 2] {
-    [
-        SampleLight::new("orange", [-2.0, 1.0, 0.0], [3.0, 1.5], [20.0, 10.0, 2.5]),
-        SampleLight::new("blue", [-2.0, 4.0, 0.0], [3.0, 1.5], [3.0, 7.0, 20.0]),
-    ]
-}
-
-/// Writes a truth scene of the stacked sample's setup with `lights` instead of its own
-/// (named `name`-truth.gltf in the samples folder), renders it as the samples are rendered,
-/// and fits the photo on the sample's scene at the defaults.
-fn render_and_fit(name: &str, lights: &[SampleLight]) -> Report {
-    let dir = sample_scenes();
-    let text = std::fs::read_to_string(dir.join("stacked-truth.gltf")).expect("stacked truth");
-    let mut doc: serde_json::Value = serde_json::from_str(&text).expect("stacked truth JSON");
-    let defs = doc["extensions"]["EXT_lights_area"]["lights"]
-        .as_array_mut()
-        .expect("the truth's lights");
-    assert_eq!(defs.len(), lights.len());
-    for (def, light) in defs.iter_mut().zip(lights) {
-        let peak = light.radiance.iter().cloned().fold(0.0, f64::max);
-        def["name"] = light.name.clone().into();
-        def["intensity"] = peak.into();
-        def["color"] = serde_json::json!(light.radiance.map(|c| c / peak));
-        def["size"] = light.height.into();
-        def["rect"] = serde_json::json!({ "aspect": light.width / light.height });
-    }
-    let nodes = doc["nodes"].as_array_mut().expect("nodes");
-    let mut k = 0;
-    for node in nodes.iter_mut() {
-        if node
-            .get("extensions")
-            .is_some_and(|e| e.get("EXT_lights_area").is_some())
-        {
-            let c = lights[k].center();
-            node["name"] = lights[k].name.clone().into();
-            node["translation"] = serde_json::json!([c.x, c.y, c.z]);
-            k += 1;
-        }
-    }
-    let truth = format!("{name}-truth.gltf");
-    std::fs::write(dir.join(&truth), doc.to_string()).expect("write the truth scene");
-    let spec = samples::SampleScene {
-        file: truth,
-        ..samples::by_photo("stacked.png").expect("the stacked sample")
-    };
-    let rendered =
-        samples::render_photo(dir, &spec, samples::PHOTO_SPP, Default::default()).expect("render");
-    let photo = dir.join(format!("{name}.png"));
-    streaklight::photo_out::write(&photo, rendered.width, rendered.height, &rendered.pixels)
-        .expect("write the photo");
-    convert(&convert_options(dir, photo, &format!("{name}-fit.gltf")))
-        .expect("fit")
-        .report
+/// `streaklight fit` of a sample photo on the sample's lightless scene at the defaults.
+fn fit(photo: &str) -> Report {
+    convert(&convert_options(
+        sample_scenes(),
+        sample_photo_path(photo),
+        &format!("{}-lamps-fit.gltf", photo.replace('.', "_")),
+    ))
+    .expect("fit")
+    .report
 }
 
 /// The fitted light nearest `truth`'s centre.
@@ -80,7 +33,8 @@ fn nearest<'a>(lights: &'a [LightReport], truth: &SampleLight) -> &'a LightRepor
         .expect("a light")
 }
 
-/// An orange lamp under a blue one, both in the photo, their reflections one streak. The
+/// An orange lamp under a blue one (`orange-blue.png`), both in the photo, their reflections
+/// one streak. The
 /// paper's estimate starts one light for the streak, and the lamps' direct images make it
 /// two. Held: two lights, every edge within 2 % of the light's size and every radiance
 /// channel within 3 % (measured: 0.03 % and 0.9 %), with no warning of lights the photo
@@ -89,8 +43,8 @@ fn nearest<'a>(lights: &'a [LightReport], truth: &SampleLight) -> &'a LightRepor
 /// and dropped a second.
 #[test]
 fn an_orange_lamp_under_a_blue_one_gives_two_lights() {
-    let truths = orange_and_blue();
-    let report = render_and_fit("orange-blue", &truths);
+    let truths = samples::orange_and_blue_lights();
+    let report = fit("orange-blue.png");
     assert_eq!(report.lights.len(), 2, "{:?}", report.warnings);
     assert!(
         report
@@ -131,13 +85,7 @@ fn an_orange_lamp_under_a_blue_one_gives_two_lights() {
 /// edges are about 5 % rms off and the upper light's radiance up to 14 %).
 #[test]
 fn stacked_lamps_in_the_photo_are_two_lights_from_the_start() {
-    let report = convert(&convert_options(
-        sample_scenes(),
-        common::pipeline::sample_photo_path("stacked.png"),
-        "stacked-lamps-fit.gltf",
-    ))
-    .expect("fit")
-    .report;
+    let report = fit("stacked.png");
     assert_eq!(report.lights.len(), 2, "{:?}", report.warnings);
     assert_eq!(
         report.settings.joint_pixels.as_deref(),

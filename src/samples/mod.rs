@@ -13,7 +13,8 @@
 //! show: Table 1's light over rougher and smoother water ([`SAMPLE_GLOSSES`]:
 //! `gloss200.png`, `gloss1000.png`), and two lights one above the other whose reflections
 //! overlap into a single streak ([`stacked_lights`]: `stacked.png`, and over smoother water
-//! [`STACKED_SMOOTH_GLOSS`]: `stacked1000.png`). `table1.exr` is
+//! [`STACKED_SMOOTH_GLOSS`]: `stacked1000.png`; an orange lamp under a blue one,
+//! [`orange_and_blue_lights`]: `orange-blue.png`). `table1.exr` is
 //! Table 1's photo as linear float, from the same render as `table1.png` (large, so not
 //! committed).
 
@@ -184,6 +185,18 @@ pub fn stacked_lights() -> Vec<SampleLight> {
     ]
 }
 
+/// The orange-and-blue sample's lamps, one above the other on the wall z = 0 with 1.5 m of
+/// dark wall between them: lower (orange) corner (-2, 1, 0), 3 x 1.5, L = (20, 10, 2.5);
+/// upper (blue) corner (-2, 4, 0), 3 x 1.5, L = (3, 7, 20). Over the default water their
+/// reflections merge into one streak, orange nearer the horizon, blue nearer the camera,
+/// and every pixel's colour says how much of it each lamp lit.
+pub fn orange_and_blue_lights() -> Vec<SampleLight> {
+    vec![
+        SampleLight::new("orange", [-2.0, 1.0, 0.0], [3.0, 1.5], [20.0, 10.0, 2.5]),
+        SampleLight::new("blue", [-2.0, 4.0, 0.0], [3.0, 1.5], [3.0, 7.0, 20.0]),
+    ]
+}
+
 /// The truth scene and photo file names of the gloss sample with water gloss `gloss`
 /// (one of [`SAMPLE_GLOSSES`]): `("gloss200-truth.gltf", "gloss200.png")` for e = 200.
 pub fn gloss_sample_files(gloss: f64) -> (String, String) {
@@ -289,6 +302,13 @@ pub fn catalogue() -> Vec<SampleScene> {
             Some("stacked1000.png"),
         )
     });
+    scenes.push(scene(
+        "orange-blue-truth.gltf",
+        "an orange lamp under a blue one, (-2, 1, 0) 3 x 1.5 L = (20, 10, 2.5) and (-2, 4, 0) 3 x 1.5 L = (3, 7, 20): their reflections overlap into one streak",
+        0.0,
+        orange_and_blue_lights(),
+        Some("orange-blue.png"),
+    ));
     scenes.push(SampleScene {
         water: SampleWater::OtherWaves,
         ..scene(

@@ -29,6 +29,7 @@ use glam::Vec3;
 
 use super::direct_images::{images_in, DirectImage};
 use super::direct_start::overlap;
+use crate::fitting::light_plane::LightPlane;
 use crate::fitting::observation::StreakObservation;
 use crate::fitting::rect::Rect;
 use crate::fitting::FittedLight;
@@ -88,9 +89,10 @@ pub(crate) fn one_light_per_lamp(
             continue;
         };
         for image in images {
-            let taken = out
-                .iter()
-                .any(|l| l.plane.same_plane(&light.plane) && intersects(&l.rect(), &image.rect));
+            let taken = out.iter().any(|l| {
+                l.plane.same_plane(&light.plane)
+                    && intersects(&in_frame(l, &light.plane), &image.rect)
+            });
             let centre = image.rect.center();
             let lamp = light.plane.point_at(centre.x, centre.y);
             if !taken && mirror_in_box(scene, photo, &pixels, lamp, height) {
@@ -98,28 +100,49 @@ pub(crate) fn one_light_per_lamp(
             }
         }
     }
-    merge_fragments(out, near.iter().flatten())
+    let images = lights
+        .iter()
+        .zip(&near)
+        .flat_map(|(l, ims)| ims.iter().map(move |im| (&l.plane, im)));
+    merge_fragments(out, images)
+}
+
+/// `light`'s rectangle in the frame of `plane`, a plane it lies on: lights of one wall found
+/// from different streaks have the same axes but their own origins.
+fn in_frame(light: &FittedLight, plane: &LightPlane) -> Rect {
+    let shift = plane.coords(light.plane.point);
+    let r = light.rect();
+    Rect {
+        u_min: r.u_min + shift.x,
+        u_max: r.u_max + shift.x,
+        v_min: r.v_min + shift.y,
+        v_max: r.v_max + shift.y,
+    }
 }
 
 /// `lights` with every light whose centre lies on a lamp's image that another light starts on
 /// (overlaps by at least [`ON_IMAGE`]) merged into that light: a fragment of the streak the
-/// paper's estimate started as a light of its own, on a lamp now taken.
+/// paper's estimate started as a light of its own, on a lamp now taken. Of two lights on one
+/// image, the first stays.
 fn merge_fragments<'a>(
     mut lights: Vec<FittedLight>,
-    images: impl Iterator<Item = &'a DirectImage>,
+    images: impl Iterator<Item = (&'a LightPlane, &'a DirectImage)>,
 ) -> Vec<FittedLight> {
-    let images: Vec<&DirectImage> = images.collect();
-    let on = |l: &FittedLight, im: &DirectImage| overlap(&l.rect(), &im.rect) >= ON_IMAGE;
+    let images: Vec<(&LightPlane, &DirectImage)> = images.collect();
+    let on = |l: &FittedLight, plane: &LightPlane, im: &DirectImage| {
+        l.plane.same_plane(plane) && overlap(&in_frame(l, plane), &im.rect) >= ON_IMAGE
+    };
     let mut k = 0;
     while k < lights.len() {
-        let c = lights[k].rect().center();
         let host = images
             .iter()
-            .filter(|im| im.rect.contains(c) && !on(&lights[k], im))
-            .find_map(|im| {
-                (0..lights.len()).find(|&j| {
-                    j != k && lights[j].plane.same_plane(&lights[k].plane) && on(&lights[j], im)
-                })
+            .filter(|(plane, im)| {
+                lights[k].plane.same_plane(plane)
+                    && im.rect.contains(in_frame(&lights[k], plane).center())
+            })
+            .find_map(|&(plane, im)| {
+                let k_on = on(&lights[k], plane, im);
+                (0..lights.len()).find(|&j| j != k && (!k_on || j < k) && on(&lights[j], plane, im))
             });
         match host {
             Some(j) => {

@@ -1,0 +1,179 @@
+//! Far, small lights: a light 1.2-1.5 m tall on a wall 16-18 m from the camera in a 16:9
+//! photo, where the lobe's footprint on the wall is about as large as the light. Rendered here
+//! from the sample setup with the wall moved back, fitted at the defaults, against the truth.
+
+mod common;
+
+use std::path::Path;
+
+use common::pipeline::sample_scenes_in;
+use serde_json::{json, Value};
+use streaklight::convert::{convert, ConvertOptions};
+use streaklight::pipeline::{FitSettings, JointSettings, Method};
+use streaklight::report::Report;
+use streaklight::samples::{self, SampleLight};
+
+/// The photo's size: 16:9, with the samples' 600 rows.
+const WIDTH: u32 = 1066;
+const HEIGHT: u32 = 600;
+
+/// `file` of the samples folder `dir` with the camera's aspect ratio 16:9 and the wall moved
+/// to z = `wall_z`; with `light` as its only light when given (it must be a truth scene).
+fn street(dir: &Path, file: &str, wall_z: f64, light: Option<&SampleLight>) -> Value {
+    let text = std::fs::read_to_string(dir.join(file)).expect("sample scene");
+    let mut doc: Value = serde_json::from_str(&text).expect("sample scene JSON");
+    doc["cameras"][0]["perspective"]["aspectRatio"] = json!(WIDTH as f64 / HEIGHT as f64);
+    for node in doc["nodes"].as_array_mut().expect("nodes") {
+        if node["name"] == "Wall" {
+            node["translation"] = json!([0.0, 0.0, wall_z]);
+        }
+        if let (Some(l), true) = (light, node["name"] == "light0") {
+            // Centred on the light, 1 mm in front of the wall as written lights are.
+            let c = l.center();
+            node["translation"] = json!([c.x, c.y, wall_z + 0.001]);
+        }
+    }
+    if let Some(l) = light {
+        let peak = l.radiance.iter().cloned().fold(0.0, f64::max);
+        let def = &mut doc["extensions"]["EXT_lights_area"]["lights"][0];
+        def["intensity"] = json!(peak);
+        def["color"] = json!(l.radiance.map(|c| c / peak));
+        def["size"] = json!(l.height);
+        def["rect"] = json!({ "aspect": l.width / l.height });
+    }
+    doc
+}
+
+/// Renders `light` on a wall at `wall_z` as the samples are rendered (256 spp, exposure 0.1,
+/// seed 1) and fits the photo at the defaults, with or without the direct view.
+fn render_and_fit(name: &str, wall_z: f64, light: &SampleLight, direct_view: bool) -> Report {
+    let dir = sample_scenes_in(name);
+    let truth = dir.join("street-truth.gltf");
+    let doc = street(&dir, "table1-truth.gltf", wall_z, Some(light));
+    std::fs::write(&truth, doc.to_string()).expect("write the truth scene");
+    let doc = street(&dir, "scene.gltf", wall_z, None);
+    std::fs::write(dir.join("street.gltf"), doc.to_string()).expect("write the scene");
+    let scene = streaklight::scene_in::load(&truth, &Default::default()).expect("truth scene");
+    let options = streaklight::render::RenderOptions {
+        width: WIDTH,
+        height: HEIGHT,
+        samples_per_pixel: samples::PHOTO_SPP,
+        exposure: samples::PHOTO_EXPOSURE,
+        seed: 1,
+        ..Default::default()
+    };
+    let rendered = streaklight::render::render(&scene, &options).expect("render");
+    let photo = dir.join("street.png");
+    streaklight::photo_out::write(&photo, rendered.width, rendered.height, &rendered.pixels)
+        .expect("write the photo");
+    let fit = match FitSettings::default().method {
+        Method::Joint(j) => Method::Joint(JointSettings { direct_view, ..j }),
+        paper => paper,
+    };
+    let options = ConvertOptions {
+        exposure: samples::PHOTO_EXPOSURE,
+        fit: FitSettings {
+            method: fit,
+            ..FitSettings::default()
+        },
+        ..ConvertOptions::new(dir.join("street.gltf"), photo, dir.join("out.gltf"))
+    };
+    let report = convert(&options).expect("fit").report;
+    let _ = std::fs::remove_dir_all(&dir);
+    report
+}
+
+/// The two far lights: 1.5 x 1.2 m on a wall 16 m from the camera (z = -6), and 1.2 x 1.5 m
+/// on a recessed facade 18 m away (z = -8), with its wall and its colour.
+fn far_lights() -> [(f64, SampleLight); 2] {
+    [
+        (
+            -6.0,
+            SampleLight::new("street", [2.0, 1.5, -6.001], [1.5, 1.2], [20.0, 16.0, 10.0]),
+        ),
+        (
+            -8.0,
+            SampleLight::new(
+                "facade",
+                [-3.0, 2.0, -8.001],
+                [1.2, 1.5],
+                [12.0, 18.0, 24.0],
+            ),
+        ),
+    ]
+}
+
+/// In the photo, each far light's direct image pins it: every edge within 1 % of its size
+/// and every radiance channel within 1 % (measured on the street: 0.01 % and 0.3 %). From the
+/// reflections alone the paper's estimate gave the street light 91 % too tall at 65 % of its
+/// radiance.
+#[test]
+fn far_small_lights_in_the_photo_within_one_percent() {
+    for (k, (wall_z, light)) in far_lights().iter().enumerate() {
+        let report = render_and_fit(&format!("far-{k}"), *wall_z, light, true);
+        assert_eq!(
+            report.lights.len(),
+            1,
+            "{}: {:?}",
+            light.name,
+            report.warnings
+        );
+        let l = &report.lights[0];
+        let edges = light.edge_errors(l.corner_left_bottom, l.width, l.height);
+        eprintln!("{}: edges {edges:?} radiance {:?}", light.name, l.radiance);
+        assert!(
+            edges.iter().all(|e| e.abs() < 0.01),
+            "{}: {edges:?}",
+            light.name
+        );
+        for ch in 0..3 {
+            let want = light.radiance[ch];
+            assert!(
+                (l.radiance[ch] - want).abs() < 0.01 * want,
+                "{} channel {ch}: {} against {want}",
+                light.name,
+                l.radiance[ch]
+            );
+        }
+    }
+}
+
+/// Without the direct view (as for a light out of frame), the reflections alone tell the far
+/// light's height and radiance only loosely: every error within 3 of its reported sigmas,
+/// and the report warns that the uncertainty is large (measured on the street: top +3.6 %
+/// at 0.4 sigma, radiance -5.2 % at 0.4 sigma, sigmas 8.6 % and 13.8 %).
+#[test]
+fn far_small_lights_from_the_reflections_alone_within_their_sigmas() {
+    let (wall_z, light) = &far_lights()[0];
+    let report = render_and_fit("far-reflections", *wall_z, light, false);
+    assert_eq!(report.lights.len(), 1, "{:?}", report.warnings);
+    let l = &report.lights[0];
+    let u = l.uncertainty.as_ref().expect("uncertainties");
+    let c = l.corner_left_bottom;
+    let errors = [
+        (c[0] - light.corner.x, u.left),
+        (c[0] + l.width - light.corner.x - light.width, u.right),
+        (c[1] - light.corner.y, u.bottom),
+        (c[1] + l.height - light.corner.y - light.height, u.top),
+    ];
+    for (k, (e, s)) in errors.iter().enumerate() {
+        let s = s.unwrap_or_else(|| panic!("edge {k} has no sigma"));
+        assert!(e.abs() < 3.0 * s, "edge {k}: {e} m against sigma {s}");
+    }
+    for ch in 0..3 {
+        let e = l.radiance[ch] - light.radiance[ch];
+        assert!(
+            e.abs() < 3.0 * u.radiance[ch],
+            "channel {ch}: {e} against sigma {}",
+            u.radiance[ch]
+        );
+    }
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("large uncertainty")),
+        "{:?}",
+        report.warnings
+    );
+}
