@@ -153,6 +153,24 @@ fn main() {
             truth: "(-2, 3, 0), 3 x 1.4, L 14",
             paper: "-",
         },
+        Case {
+            name: "orange-blue, orange lamp",
+            scene: "scene.gltf",
+            photo: "orange-blue.png",
+            gloss: None,
+            centre: (-0.5, 1.75),
+            truth: "(-2, 1, 0), 3 x 1.5, L (20, 10, 2.5)",
+            paper: "-",
+        },
+        Case {
+            name: "orange-blue, blue lamp",
+            scene: "scene.gltf",
+            photo: "orange-blue.png",
+            gloss: None,
+            centre: (-0.5, 4.75),
+            truth: "(-2, 4, 0), 3 x 1.5, L (3, 7, 20)",
+            paper: "-",
+        },
     ];
     println!(
         "| case | truth | paper | method | streaklight | unconstrained edges | fit time (s) |"
