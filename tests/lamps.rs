@@ -146,8 +146,8 @@ fn pitched_down(dir: &Path, file: &str, degrees: f64, name: &str) -> PathBuf {
 /// streak's light from the reflections alone, where each pixel's colour says how much of it
 /// each lamp lit. Held: two lights, neither seen directly, every edge within 2 % of its
 /// light's size and every radiance channel within 3 % of its light's largest channel
-/// (measured: edges within 1.1 %, channels within 1.4 % of the largest; the blue lamp's weak
-/// red channel, 3 of its 20, is 5.5 % of its own value low), and the warning that the
+/// (measured: edges within 0.62 %, channels within 0.9 % of the largest; the blue lamp's weak
+/// red channel, 3 of its 20, is 3.0 % of its own value low), and the warning that the
 /// reflections alone tell such lights apart only weakly.
 #[test]
 fn orange_and_blue_lamps_out_of_frame_are_split_by_their_colours() {
