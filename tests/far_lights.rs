@@ -6,7 +6,9 @@ mod common;
 
 use std::path::Path;
 
+use common::fit_case::render_like_samples;
 use common::pipeline::sample_scenes_in;
+use common::truth::{assert_light_within, RadianceBar::OfChannel};
 use serde_json::{json, Value};
 use streaklight::convert::{convert, ConvertOptions};
 use streaklight::pipeline::{FitSettings, JointSettings, Method};
@@ -53,19 +55,8 @@ fn render_and_fit(name: &str, wall_z: f64, light: &SampleLight, direct_view: boo
     std::fs::write(&truth, doc.to_string()).expect("write the truth scene");
     let doc = street(&dir, "scene.gltf", wall_z, None);
     std::fs::write(dir.join("street.gltf"), doc.to_string()).expect("write the scene");
-    let scene = streaklight::scene_in::load(&truth, &Default::default()).expect("truth scene");
-    let options = streaklight::render::RenderOptions {
-        width: WIDTH,
-        height: HEIGHT,
-        samples_per_pixel: samples::PHOTO_SPP,
-        exposure: samples::PHOTO_EXPOSURE,
-        seed: 1,
-        ..Default::default()
-    };
-    let rendered = streaklight::render::render(&scene, &options).expect("render");
     let photo = dir.join("street.png");
-    streaklight::photo_out::write(&photo, rendered.width, rendered.height, &rendered.pixels)
-        .expect("write the photo");
+    render_like_samples(&truth, &photo, WIDTH, HEIGHT);
     let fit = match FitSettings::default().method {
         Method::Joint(j) => Method::Joint(JointSettings { direct_view, ..j }),
         paper => paper,
@@ -118,23 +109,7 @@ fn far_small_lights_in_the_photo_within_one_percent() {
             light.name,
             report.warnings
         );
-        let l = &report.lights[0];
-        let edges = light.edge_errors(l.corner_left_bottom, l.width, l.height);
-        eprintln!("{}: edges {edges:?} radiance {:?}", light.name, l.radiance);
-        assert!(
-            edges.iter().all(|e| e.abs() < 0.01),
-            "{}: {edges:?}",
-            light.name
-        );
-        for ch in 0..3 {
-            let want = light.radiance[ch];
-            assert!(
-                (l.radiance[ch] - want).abs() < 0.01 * want,
-                "{} channel {ch}: {} against {want}",
-                light.name,
-                l.radiance[ch]
-            );
-        }
+        assert_light_within("far", &report.lights[0], light, 0.01, OfChannel(0.01));
     }
 }
 

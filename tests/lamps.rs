@@ -6,10 +6,12 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
+use common::fit_case::render_like_samples;
 use common::pipeline::{convert_options, sample_photo_path, sample_scenes};
+use common::truth::{assert_light_within, nearest, RadianceBar::*};
 use streaklight::convert::{convert, ConvertOptions};
-use streaklight::report::{LightReport, Report};
-use streaklight::samples::{self, SampleLight};
+use streaklight::report::Report;
+use streaklight::samples;
 
 /// `streaklight fit` of a sample photo on the sample's lightless scene at the defaults.
 fn fit(photo: &str) -> Report {
@@ -20,20 +22,6 @@ fn fit(photo: &str) -> Report {
     ))
     .expect("fit")
     .report
-}
-
-/// The fitted light nearest `truth`'s centre.
-fn nearest<'a>(lights: &'a [LightReport], truth: &SampleLight) -> &'a LightReport {
-    let c = truth.center();
-    let dist = |l: &LightReport| {
-        let x = l.corner_left_bottom[0] + l.width / 2.0 - c.x;
-        let y = l.corner_left_bottom[1] + l.height / 2.0 - c.y;
-        x * x + y * y
-    };
-    lights
-        .iter()
-        .min_by(|a, b| dist(a).total_cmp(&dist(b)))
-        .expect("a light")
 }
 
 /// An orange lamp under a blue one (`orange-blue.png`), both in the photo, their reflections
@@ -58,25 +46,7 @@ fn an_orange_lamp_under_a_blue_one_gives_two_lights() {
     );
     for truth in &truths {
         let light = nearest(&report.lights, truth);
-        let edges = truth.edge_errors(light.corner_left_bottom, light.width, light.height);
-        eprintln!(
-            "{}: edges {edges:?} radiance {:?}",
-            truth.name, light.radiance
-        );
-        assert!(
-            edges.iter().all(|e| e.abs() < 0.02),
-            "{}: {edges:?}",
-            truth.name
-        );
-        for ch in 0..3 {
-            let want = truth.radiance[ch];
-            assert!(
-                (light.radiance[ch] - want).abs() < 0.03 * want,
-                "{} channel {ch}: {} against {want}",
-                truth.name,
-                light.radiance[ch]
-            );
-        }
+        assert_light_within("in the photo", light, truth, 0.02, OfChannel(0.03));
     }
 }
 
@@ -103,25 +73,7 @@ fn stacked_lamps_in_the_photo_are_two_lights_from_the_start() {
     );
     for truth in &samples::stacked_lights() {
         let light = nearest(&report.lights, truth);
-        let edges = truth.edge_errors(light.corner_left_bottom, light.width, light.height);
-        eprintln!(
-            "{}: edges {edges:?} radiance {:?}",
-            truth.name, light.radiance
-        );
-        assert!(
-            edges.iter().all(|e| e.abs() < 0.01),
-            "{}: {edges:?}",
-            truth.name
-        );
-        for ch in 0..3 {
-            let want = truth.radiance[ch];
-            assert!(
-                (light.radiance[ch] - want).abs() < 0.01 * want,
-                "{} channel {ch}: {} against {want}",
-                truth.name,
-                light.radiance[ch]
-            );
-        }
+        assert_light_within("stacked", light, truth, 0.01, OfChannel(0.01));
     }
 }
 
@@ -159,19 +111,8 @@ fn orange_and_blue_lamps_out_of_frame_are_split_by_their_colours() {
         "orange-blue-down-truth.gltf",
     );
     let scene = pitched_down(dir, "scene.gltf", 27.5, "scene-down.gltf");
-    let loaded = streaklight::scene_in::load(&truth, &Default::default()).expect("truth scene");
-    let options = streaklight::render::RenderOptions {
-        width: samples::PHOTO_SIZE,
-        height: samples::PHOTO_SIZE,
-        samples_per_pixel: samples::PHOTO_SPP,
-        exposure: samples::PHOTO_EXPOSURE,
-        seed: 1,
-        ..Default::default()
-    };
-    let rendered = streaklight::render::render(&loaded, &options).expect("render");
     let photo = dir.join("orange-blue-down.png");
-    streaklight::photo_out::write(&photo, rendered.width, rendered.height, &rendered.pixels)
-        .expect("write the photo");
+    render_like_samples(&truth, &photo, samples::PHOTO_SIZE, samples::PHOTO_SIZE);
     let report = convert(&ConvertOptions {
         exposure: samples::PHOTO_EXPOSURE,
         ..ConvertOptions::new(scene, photo, dir.join("orange-blue-down-fit.gltf"))
@@ -194,25 +135,6 @@ fn orange_and_blue_lamps_out_of_frame_are_split_by_their_colours() {
             "{} is seen directly",
             truth.name
         );
-        let edges = truth.edge_errors(light.corner_left_bottom, light.width, light.height);
-        eprintln!(
-            "{} out of frame: edges {edges:?} radiance {:?}",
-            truth.name, light.radiance
-        );
-        assert!(
-            edges.iter().all(|e| e.abs() < 0.02),
-            "{}: {edges:?}",
-            truth.name
-        );
-        let peak = truth.radiance.iter().cloned().fold(0.0, f64::max);
-        for ch in 0..3 {
-            let want = truth.radiance[ch];
-            assert!(
-                (light.radiance[ch] - want).abs() < 0.03 * peak,
-                "{} channel {ch}: {} against {want}",
-                truth.name,
-                light.radiance[ch]
-            );
-        }
+        assert_light_within("out of frame", light, truth, 0.02, OfPeak(0.03));
     }
 }

@@ -59,6 +59,23 @@ pub fn render_photo_from(
     streaklight::photo_out::write(photo, width, height, &image.pixels).unwrap();
 }
 
+/// Renders the scene file `scene` (with its lights) to the PNG `photo` as the sample photos
+/// are rendered (256 spp, the samples' exposure, seed 1), at `width` x `height`.
+pub fn render_like_samples(scene: &Path, photo: &Path, width: u32, height: u32) {
+    let loaded = scene_in::load(scene, &LoadOptions::default())
+        .unwrap_or_else(|e| panic!("loading {}: {e}", scene.display()));
+    let options = RenderOptions {
+        width,
+        height,
+        samples_per_pixel: streaklight::samples::PHOTO_SPP,
+        exposure: streaklight::samples::PHOTO_EXPOSURE,
+        seed: 1,
+        ..Default::default()
+    };
+    let image = render::render(&loaded, &options).expect("render");
+    streaklight::photo_out::write(photo, width, height, &image.pixels).expect("write the photo");
+}
+
 /// A uniform 8-bit RGB PNG.
 pub fn uniform_png(path: &Path, width: u32, height: u32, value: u8) {
     let img = image::RgbImage::from_pixel(width, height, image::Rgb([value; 3]));

@@ -51,3 +51,6 @@ pub use cli::run_cli;
 pub use dirs::temp_dir;
 #[allow(unused_imports)]
 pub use gltf_builder::{flat_grid, paper_setup, TestScene};
+
+/// A fitted light against the sample light it stands for.
+pub mod truth;
