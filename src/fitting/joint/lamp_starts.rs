@@ -242,3 +242,101 @@ fn mirror_in_box(scene: &Scene, photo: &Photo, pixels: &[u32], lamp: Vec3, heigh
         && y >= y0 as f32 - margin
         && y <= y1 as f32 + 1.0 + margin
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fitting::EdgeStatus;
+
+    fn rect(u_min: f32, u_max: f32, v_min: f32, v_max: f32) -> Rect {
+        Rect {
+            u_min,
+            u_max,
+            v_min,
+            v_max,
+        }
+    }
+
+    fn image(r: Rect) -> DirectImage {
+        DirectImage {
+            first_pixel: 0,
+            rect: r,
+            enclosed: true,
+            reach: r,
+        }
+    }
+
+    /// The wall z = 0 facing +z, its frame's origin at `origin` on it.
+    fn wall(origin: Vec3) -> LightPlane {
+        LightPlane::with_frame((0, 0, 0), origin, Vec3::Z, Vec3::X, 1.0).expect("a plane")
+    }
+
+    fn light(plane: &LightPlane, r: Rect, streak: usize) -> FittedLight {
+        let free = || EdgeStatus::Constrained { pixels: 1 };
+        FittedLight {
+            streak_ids: vec![streak],
+            plane: plane.clone(),
+            u_min: r.u_min,
+            u_max: r.u_max,
+            v_min: r.v_min,
+            v_max: r.v_max,
+            radiance: [1.0; 3],
+            edges: [free(), free(), free(), free()],
+        }
+    }
+
+    /// Two lamps 3 x 1.5 m with 1.5 m between them, each a third of the box around both,
+    /// under one start: two. A third lamp under it, or one of the two a tenth of the box (a
+    /// sign's letter beside a lamp), or one image alone: not two.
+    #[test]
+    fn a_start_over_exactly_two_large_images_is_two_lamps() {
+        let start = rect(0.0, 3.0, 0.0, 4.5);
+        let (lower, upper) = (rect(0.0, 3.0, 0.0, 1.5), rect(0.0, 3.0, 3.0, 4.5));
+        let images = [image(lower), image(upper)];
+        let got = two_lamps(&start, &images).expect("two lamps");
+        assert_eq!([got[0].rect, got[1].rect], [lower, upper]);
+        let three = [image(lower), image(upper), image(rect(4.0, 5.0, 0.0, 1.0))];
+        let wide = rect(0.0, 6.0, 0.0, 4.5);
+        assert!(two_lamps(&wide, &three).is_none());
+        let letter = [image(lower), image(rect(0.0, 0.3, 3.0, 4.5))];
+        assert!(two_lamps(&start, &letter).is_none());
+        assert!(two_lamps(&start, &[image(lower)]).is_none());
+        // Not under the start: not counted.
+        assert!(two_lamps(&rect(0.0, 3.0, 0.0, 1.0), &images).is_none());
+    }
+
+    /// A rectangle in one light's frame moves into another frame of the same wall by the
+    /// offset between the frames' origins.
+    #[test]
+    fn a_rectangle_moves_between_frames_of_one_wall() {
+        let (a, b) = (wall(Vec3::ZERO), wall(Vec3::new(2.0, -1.0, 0.0)));
+        let l = light(&b, rect(0.0, 1.0, 0.0, 1.0), 0);
+        assert_eq!(in_frame(&l, &a), rect(2.0, 3.0, -1.0, 0.0));
+        assert_eq!(in_frame(&l, &b), l.rect());
+    }
+
+    /// A fragment's light whose centre lies on a lamp's image that another light starts on
+    /// merges into that light, its streak joining, even where the two lights' frames have
+    /// other origins; of two lights on one image the first stays; a light on no image, or on
+    /// an image no other light is on, stays.
+    #[test]
+    fn fragments_on_a_taken_lamp_merge_into_its_light() {
+        let (a, b) = (wall(Vec3::ZERO), wall(Vec3::new(2.0, 0.0, 0.0)));
+        let lamp = image(rect(0.0, 3.0, 0.0, 1.5));
+        let on_lamp = light(&a, rect(0.0, 3.0, 0.0, 1.5), 0);
+        // In b's frame: u from -2 (a's 0). Centre (0.5 - 2 + 2, ...) = a's (0.5, 0.75).
+        let fragment = light(&b, rect(-2.0, -1.0, 0.7, 0.8), 1);
+        let elsewhere = light(&a, rect(5.0, 6.0, 0.0, 1.0), 2);
+        let twin = light(&b, rect(-2.0, 1.0, 0.0, 1.5), 3);
+        let out = merge_fragments(
+            vec![on_lamp, fragment, elsewhere, twin],
+            [(&a, &lamp)].into_iter(),
+        );
+        assert_eq!(out.len(), 2);
+        assert_eq!(out[0].streak_ids, vec![0, 1, 3]);
+        assert_eq!(out[1].streak_ids, vec![2]);
+        let alone = light(&a, rect(0.5, 1.0, 0.5, 1.0), 4);
+        let out = merge_fragments(vec![alone], [(&a, &lamp)].into_iter());
+        assert_eq!(out.len(), 1, "no other light is on the lamp");
+    }
+}
