@@ -2,7 +2,8 @@
 //! loading the same scene and rendering it once in a fresh process, measured side by side.
 //!
 //! `cargo bench --bench speed` fits the Table 1 photo at the defaults and with `--gloss auto`,
-//! the stacked photo (two lights in one streak), and a 1920 x 1080 render of the Table 1
+//! the stacked photo (two lights in one streak; with their lamps in frame as the photo shows
+//! them, and from the reflections alone, `--no-direct-view`, as for lamps out of frame), and a 1920 x 1080 render of the Table 1
 //! scene, each as a child process (`streaklight fit`, wall time and peak resident memory),
 //! renders the Table 1 scene with Mitsuba at both sizes (mitsuba_render.py beside this file,
 //! 64 spp, path depth 3, in a fresh process each time) and prints every figure, its ratio to
@@ -305,10 +306,19 @@ fn speed(dir: &Path, runs: usize, long_runs: usize) {
             long_runs,
         ),
         Case::new(
-            "overlap fit, stacked.png",
+            "overlap fit, stacked.png (lamps in frame)",
             &scene,
             &stacked,
             &[],
+            0,
+            1.0,
+            long_runs,
+        ),
+        Case::new(
+            "overlap fit, stacked.png, `--no-direct-view` (as out of frame)",
+            &scene,
+            &stacked,
+            &["--no-direct-view"],
             0,
             1.0,
             long_runs,
