@@ -91,7 +91,7 @@ pub(crate) fn one_light_per_lamp(
         for image in images {
             let taken = out.iter().any(|l| {
                 l.plane.same_plane(&light.plane)
-                    && intersects(&in_frame(l, &light.plane), &image.rect)
+                    && overlap(&in_frame(l, &light.plane), &image.rect) > 0.0
             });
             let centre = image.rect.center();
             let lamp = light.plane.point_at(centre.x, centre.y);
@@ -163,7 +163,7 @@ fn merge_fragments<'a>(
 fn two_lamps<'a>(start: &Rect, images: &'a [DirectImage]) -> Option<[&'a DirectImage; 2]> {
     let under: Vec<&DirectImage> = images
         .iter()
-        .filter(|im| intersects(start, &im.rect))
+        .filter(|im| overlap(start, &im.rect) > 0.0)
         .collect();
     let [a, b] = under[..] else {
         return None;
@@ -176,7 +176,7 @@ fn two_lamps<'a>(start: &Rect, images: &'a [DirectImage]) -> Option<[&'a DirectI
     };
     let area = |r: &Rect| r.width() * r.height();
     let big = |im: &DirectImage| area(&im.rect) >= MIN_LAMP_SHARE * area(&around);
-    (big(a) && big(b) && !intersects(&a.rect, &b.rect)).then_some([a, b])
+    (big(a) && big(b) && overlap(&a.rect, &b.rect) == 0.0).then_some([a, b])
 }
 
 /// `light` started on `image`'s rectangle.
@@ -187,11 +187,6 @@ fn on_image(light: &FittedLight, image: &DirectImage) -> FittedLight {
     out.v_min = image.rect.v_min;
     out.v_max = image.rect.v_max;
     out
-}
-
-/// Whether two rectangles share any area.
-fn intersects(a: &Rect, b: &Rect) -> bool {
-    a.u_min < b.u_max && b.u_min < a.u_max && a.v_min < b.v_max && b.v_min < a.v_max
 }
 
 /// The median height (world y) where the camera rays through up to [`HEIGHT_PROBES`] of
