@@ -90,8 +90,7 @@ pub(crate) fn one_light_per_lamp(
         };
         for image in images {
             let taken = out.iter().any(|l| {
-                l.plane.same_plane(&light.plane)
-                    && overlap(&in_frame(l, &light.plane), &image.rect) > 0.0
+                l.plane.same_plane(&light.plane) && in_frame(l, &light.plane).overlaps(&image.rect)
             });
             let centre = image.rect.center();
             let lamp = light.plane.point_at(centre.x, centre.y);
@@ -163,20 +162,15 @@ fn merge_fragments<'a>(
 fn two_lamps<'a>(start: &Rect, images: &'a [DirectImage]) -> Option<[&'a DirectImage; 2]> {
     let under: Vec<&DirectImage> = images
         .iter()
-        .filter(|im| overlap(start, &im.rect) > 0.0)
+        .filter(|im| start.overlaps(&im.rect))
         .collect();
     let [a, b] = under[..] else {
         return None;
     };
-    let around = Rect {
-        u_min: a.rect.u_min.min(b.rect.u_min),
-        u_max: a.rect.u_max.max(b.rect.u_max),
-        v_min: a.rect.v_min.min(b.rect.v_min),
-        v_max: a.rect.v_max.max(b.rect.v_max),
-    };
+    let around = a.rect.union(&b.rect);
     let area = |r: &Rect| r.width() * r.height();
     let big = |im: &DirectImage| area(&im.rect) >= MIN_LAMP_SHARE * area(&around);
-    (big(a) && big(b) && overlap(&a.rect, &b.rect) == 0.0).then_some([a, b])
+    (big(a) && big(b) && !a.rect.overlaps(&b.rect)).then_some([a, b])
 }
 
 /// `light` started on `image`'s rectangle.
