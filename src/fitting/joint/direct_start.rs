@@ -167,7 +167,6 @@ fn direct_image(
 mod tests {
     use super::*;
     use crate::fitting::light_plane::LightPlane;
-    use crate::fitting::EdgeStatus;
 
     /// Table 1's scene and photo (one 3 m x 3 m light on the wall, in frame), the wall as a
     /// light plane, and the light's true rectangle on it (from the sample's definition).
@@ -205,19 +204,7 @@ mod tests {
         }
     }
 
-    fn light(plane: &LightPlane, rect: Rect, streak: usize) -> FittedLight {
-        let free = || EdgeStatus::Constrained { pixels: 1 };
-        FittedLight {
-            streak_ids: vec![streak],
-            plane: plane.clone(),
-            u_min: rect.u_min,
-            u_max: rect.u_max,
-            v_min: rect.v_min,
-            v_max: rect.v_max,
-            radiance: [1.0; 3],
-            edges: [free(), free(), free(), free()],
-        }
-    }
+    use crate::fitting::joint::fixture::start_light as light;
 
     /// A start 14 m wide and 1 cm tall across the light (as the reflections alone gave one)
     /// moves onto the light's direct image: every edge within a pixel's footprint on the

@@ -1,6 +1,7 @@
 //! Test fixture of the joint fit's unit tests: Table 3's photo and scene, light0 as the paper
 //! fits it, and every 8th pixel of its fitted region, for the tests that trace samples
-//! (in `samples`, `ramps` and `control_variate`).
+//! (in `samples`, `ramps` and `control_variate`); a start light on a plane (in
+//! `direct_start` and `lamp_starts`).
 
 use super::region::{region, region_of_interest};
 use super::samples::{trace_samples, PlaneSamples};
@@ -85,5 +86,25 @@ impl Table3Light0 {
             self.pixels.len(),
             crate::progress::Reporter::default(),
         )
+    }
+}
+
+/// A light on `plane` over `rect` explaining streak `streak`, radiance 1, every edge
+/// constrained: a start as the joint fit receives one.
+pub(super) fn start_light(
+    plane: &crate::fitting::light_plane::LightPlane,
+    rect: Rect,
+    streak: usize,
+) -> FittedLight {
+    let free = || crate::fitting::EdgeStatus::Constrained { pixels: 1 };
+    FittedLight {
+        streak_ids: vec![streak],
+        plane: plane.clone(),
+        u_min: rect.u_min,
+        u_max: rect.u_max,
+        v_min: rect.v_min,
+        v_max: rect.v_max,
+        radiance: [1.0; 3],
+        edges: [free(), free(), free(), free()],
     }
 }

@@ -235,7 +235,6 @@ fn mirror_in_box(scene: &Scene, photo: &Photo, pixels: &[u32], lamp: Vec3, heigh
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fitting::EdgeStatus;
 
     fn rect(u_min: f32, u_max: f32, v_min: f32, v_max: f32) -> Rect {
         Rect {
@@ -260,19 +259,7 @@ mod tests {
         LightPlane::with_frame((0, 0, 0), origin, Vec3::Z, Vec3::X, 1.0).expect("a plane")
     }
 
-    fn light(plane: &LightPlane, r: Rect, streak: usize) -> FittedLight {
-        let free = || EdgeStatus::Constrained { pixels: 1 };
-        FittedLight {
-            streak_ids: vec![streak],
-            plane: plane.clone(),
-            u_min: r.u_min,
-            u_max: r.u_max,
-            v_min: r.v_min,
-            v_max: r.v_max,
-            radiance: [1.0; 3],
-            edges: [free(), free(), free(), free()],
-        }
-    }
+    use crate::fitting::joint::fixture::start_light as light;
 
     /// Two lamps 3 x 1.5 m with 1.5 m between them, each a third of the box around both,
     /// under one start: two. A third lamp under it, or one of the two a tenth of the box (a
