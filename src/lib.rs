@@ -51,9 +51,11 @@
 //! # }
 //! ```
 
+pub mod background;
 pub mod batch;
 pub mod convert;
 pub mod debug_pictures;
+pub mod environment;
 pub mod error;
 pub mod fitting;
 pub mod input_file;

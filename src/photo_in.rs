@@ -29,6 +29,8 @@ pub struct Photo {
     pub display: Vec<[f32; 3]>,
     /// True when the file held floating-point (linear, unclipped) values.
     pub is_linear_float: bool,
+    /// The exposure the file's linear values were divided by.
+    pub exposure: f32,
     /// What the user should know about the file's values (negative values read as 0).
     pub warnings: Vec<String>,
 }
@@ -83,6 +85,24 @@ impl Photo {
         y as usize * self.width as usize + x as usize
     }
 
+    /// The photo less a `background` of the same size (radiance per pixel): each pixel's
+    /// radiance less the background's, at least 0, its display colour re-encoded from it. A
+    /// clipped pixel stays clipped (a lower bound on the lights' part too, less the
+    /// background) and keeps its display colour.
+    pub fn less(&self, background: &[[f32; 3]]) -> Photo {
+        let mut out = self.clone();
+        for (i, b) in background.iter().enumerate().take(out.radiance.len()) {
+            let r = &mut out.radiance[i];
+            for c in 0..3 {
+                r[c] = (r[c] - b[c]).max(0.0);
+            }
+            if !out.clipped[i] {
+                out.display[i] = r.map(|c| linear_to_srgb((c * self.exposure).clamp(0.0, 1.0)));
+            }
+        }
+        out
+    }
+
     /// Builds a photo from sRGB-encoded values in [0, 1] (as an 8-bit file would hold them,
     /// divided by 255), marking values at 1 as clipped.
     pub fn from_display(width: u32, height: u32, display: Vec<[f32; 3]>, exposure: f32) -> Self {
@@ -101,6 +121,7 @@ impl Photo {
             clipped,
             display,
             is_linear_float: false,
+            exposure,
             warnings: Vec::new(),
         }
     }
@@ -121,6 +142,7 @@ impl Photo {
             clipped,
             display,
             is_linear_float: true,
+            exposure,
             warnings: Vec::new(),
         }
     }

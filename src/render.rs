@@ -4,8 +4,8 @@
 //! Per pixel, jittered camera rays integrate over the pixel's footprint (method §2). A camera
 //! ray that hits a light sees its radiance; one that hits the water samples the reflection
 //! lobe a few times and each reflected ray sees the light it reaches unoccluded, if any;
-//! everything else is black
-//! (night). Each pixel draws its random numbers from its own stream, so the image does not
+//! everything else is black (night), or with an [`Environment`] the dim sky and the walls
+//! it lights. Each pixel draws its random numbers from its own stream, so the image does not
 //! depend on how many threads render it.
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -14,6 +14,7 @@ use std::time::Instant;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use crate::environment::Environment;
 use crate::optics::{ReflectionModel, Shadowing};
 use crate::progress::Reporter;
 use crate::random::Rng;
@@ -44,6 +45,8 @@ pub struct RenderOptions<'a> {
     /// a statistical model renders its expected image instead (the mean over the waves it
     /// describes), as the fit under that model sees the photo.
     pub water: Option<&'a dyn WaterModel>,
+    /// What rays that reach no light see: `None` for a black night.
+    pub environment: Option<Environment>,
 }
 
 impl Default for RenderOptions<'_> {
@@ -57,6 +60,7 @@ impl Default for RenderOptions<'_> {
             shadowing: Shadowing::None,
             progress: Reporter::default(),
             water: None,
+            environment: None,
         }
     }
 }
@@ -285,6 +289,7 @@ pub fn render_with_lights(
                         lights,
                         &model,
                         options.water,
+                        options.environment.filter(|e| !e.is_black()).as_ref(),
                         PixelSample {
                             x: x as u32,
                             y: y as u32,
@@ -355,6 +360,7 @@ fn pixel_sample(
     lights: &[AreaLight],
     model: &ReflectionModel,
     water_model: Option<&dyn WaterModel>,
+    environment: Option<&Environment>,
     s: PixelSample,
     w: u32,
     h: u32,
@@ -369,7 +375,13 @@ fn pixel_sample(
     let (x, y) = (s.x as f32 + fx, s.y as f32 + fy);
     let water = match camera_hit(scene, lights, x, y, w, h) {
         CameraHit::Light(i) => return (lights[i].radiance, 0),
-        CameraHit::Other => return ([0.0; 3], 0),
+        CameraHit::Other => {
+            let seen = environment.map_or([0.0; 3], |env| {
+                let dir = scene.camera.direction(x, y, w, h);
+                env.seen(scene, lights, scene.camera.position, dir, 0.0, rng)
+            });
+            return (seen, 0);
+        }
         CameraHit::Water(water) => water,
     };
     // Under another water model the camera ray meets that model's surface (a statistical
@@ -393,12 +405,16 @@ fn pixel_sample(
             continue;
         };
         traced += 1;
-        if let Some(i) = visible_light(scene, lights, water.start, sample.wi, water.tmin(sample.wi))
-        {
-            let l = lights[i].radiance;
-            for c in 0..3 {
-                sum[c] += l[c] * sample.weight;
-            }
+        let tmin = water.tmin(sample.wi);
+        let seen = match visible_light(scene, lights, water.start, sample.wi, tmin) {
+            Some(i) => lights[i].radiance,
+            None => match environment {
+                Some(env) => env.seen(scene, lights, water.start, sample.wi, tmin, rng),
+                None => continue,
+            },
+        };
+        for c in 0..3 {
+            sum[c] += seen[c] * sample.weight;
         }
     }
     let inv = 1.0 / s.lobe_samples as f32;

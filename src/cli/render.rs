@@ -50,9 +50,28 @@ pub struct Args {
     /// the samples: 200-1000), overriding its material's roughness.
     #[arg(long, value_name = "E", value_parser = super::values::positive_f32)]
     pub gloss: Option<f32>,
+    /// Linear radiance of a dim sky that every ray leaving the scene sees, one value or
+    /// R,G,B (>= 0; a night sky is about 1/1000 of a lamp's radiance; default black).
+    #[arg(long, value_name = "L", value_parser = super::values::colour)]
+    pub sky: Option<[f32; 3]>,
+    /// Diffuse albedo of every surface that is not water, 0 to 1 (a facade: 0.1-0.4; default
+    /// 0, black walls), lit by the sky and the lights.
+    #[arg(long, value_name = "A", value_parser = super::values::unit_interval)]
+    pub albedo: Option<f32>,
     /// Camera, water and units.
     #[command(flatten)]
     pub scene_options: SceneArgs,
+}
+
+impl Args {
+    /// The sky and walls asked for, `None` for a black night.
+    fn environment(&self) -> Option<streaklight::environment::Environment> {
+        let env = streaklight::environment::Environment {
+            sky: self.sky.unwrap_or([0.0; 3]),
+            albedo: self.albedo.unwrap_or(0.0),
+        };
+        (!env.is_black()).then_some(env)
+    }
 }
 
 /// Runs the command.
@@ -89,6 +108,7 @@ pub fn run(args: Args, out: &Output) -> streaklight::Result<()> {
         shadowing: args.scene_options.shadowing(),
         progress: out.progress(),
         water: None,
+        environment: args.environment(),
     };
     let image = render(&scene, &options)?;
     photo_out::write(&args.output, image.width, image.height, &image.pixels)?;

@@ -39,6 +39,22 @@ pub fn non_negative_f64(s: &str) -> Result<f64, String> {
     number_where(s, "a number of 0 or more", |v| v >= 0.0)
 }
 
+/// A linear colour of zero or more per channel: one value for grey, or R,G,B.
+pub fn colour(s: &str) -> Result<[f32; 3], String> {
+    let range = "one number of 0 or more, or three as R,G,B";
+    let parts: Vec<&str> = s.split(',').collect();
+    let values = parts
+        .iter()
+        .map(|p| number_where(p, range, |v| v >= 0.0 && v <= f32::MAX as f64).map(|v| v as f32))
+        .collect::<Result<Vec<f32>, String>>()
+        .map_err(|_| format!("must be {range}, got \"{s}\""))?;
+    match values[..] {
+        [v] => Ok([v; 3]),
+        [r, g, b] => Ok([r, g, b]),
+        _ => Err(format!("must be {range}, got \"{s}\"")),
+    }
+}
+
 /// A value in [0, 1] (a fraction of the encoding's maximum).
 pub fn unit_interval(s: &str) -> Result<f32, String> {
     number_where(s, "a number from 0 to 1", |v| (0.0..=1.0).contains(&v)).map(|v| v as f32)
@@ -161,6 +177,12 @@ mod tests {
         for (parse, bad, range) in cases {
             let e = parse(bad).unwrap_err();
             assert!(e.contains(range) && e.contains(bad), "{e}");
+        }
+        assert_eq!(colour("0.5"), Ok([0.5; 3]));
+        assert_eq!(colour("0.1, 0.2,0.3"), Ok([0.1, 0.2, 0.3]));
+        for bad in ["-1", "1,2", "1,2,3,4", "x", "1,,2", "nan,1,1"] {
+            let e = colour(bad).unwrap_err();
+            assert!(e.contains("R,G,B") && e.contains(bad), "{e}");
         }
         assert!(non_negative_f64("-0.001")
             .unwrap_err()

@@ -5,11 +5,13 @@
 //!
 //! | file | what |
 //! |---|---|
+//! | `background` | the measured background beside the photo less it |
 //! | `font` | the bitmap font of the pictures' text |
 //! | `canvas` | headers with titles and keys, labels, outlines, panels side by side |
 //! | `residual` | the signed residual's colours and scale |
 //! | `html` | `index.html` |
 
+pub mod background;
 pub mod canvas;
 pub mod font;
 pub mod html;
@@ -93,6 +95,19 @@ pub fn write(
     streaks::report::write_report(&json, &lit.segmentation, None, &options.fit.streaks)?;
     written.push(json);
 
+    if let Some(b) = &lit.background {
+        let path = dir.join(background::BACKGROUND_PICTURE);
+        write_png(&path, &background::picture(photo, b))?;
+        written.push(path);
+        figures.push(Figure {
+            file: background::BACKGROUND_PICTURE.into(),
+            caption: "the night's smooth background (dim sky, lit facades and their \
+                      reflections), measured away from the lights and taken off the photo \
+                      before the fit, and the photo less it"
+                .into(),
+        });
+    }
+
     let fit = fit_picture(scene, photo, lit, options)?;
     let path = dir.join(FIT_PICTURE);
     write_png(&path, &fit)?;
@@ -119,7 +134,12 @@ pub const INDEX: &str = "index.html";
 /// Every file [`write`] writes into its folder.
 pub fn file_names() -> Vec<&'static str> {
     let mut names = streaks::pictures::PICTURE_NAMES.to_vec();
-    names.extend([streaks::pictures::STREAKS_JSON, FIT_PICTURE, INDEX]);
+    names.extend([
+        streaks::pictures::STREAKS_JSON,
+        background::BACKGROUND_PICTURE,
+        FIT_PICTURE,
+        INDEX,
+    ]);
     names
 }
 
@@ -143,12 +163,13 @@ fn render_lights(
             shadowing: options.fit.shadowing,
             progress: options.progress,
             water,
+            environment: None,
         },
     )?;
     Ok(image.pixels)
 }
 
-fn srgb_image(width: u32, height: u32, pixels: &[[f32; 3]]) -> RgbImage {
+pub(crate) fn srgb_image(width: u32, height: u32, pixels: &[[f32; 3]]) -> RgbImage {
     let mut img = RgbImage::new(width, height);
     for (px, p) in img.pixels_mut().zip(pixels) {
         *px = Rgb(p.map(|c| (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0).round() as u8));
@@ -246,10 +267,24 @@ fn fit_picture(
         .iter()
         .map(|p| p.map(|c| c * options.exposure))
         .collect();
+    // The model is the lights' reflections plus the background the fit took off the photo.
+    let background = |i: usize| {
+        lit.background
+            .as_ref()
+            .map_or([0.0; 3], |b| b.pixels[i].map(|c| c * options.exposure))
+    };
     let model: Vec<[f32; 3]> = model
         .iter()
         .zip(water)
-        .map(|(m, &w)| if w { *m } else { [0.0; 3] })
+        .enumerate()
+        .map(|(i, (m, &w))| {
+            if w {
+                let b = background(i);
+                [m[0] + b[0], m[1] + b[1], m[2] + b[2]]
+            } else {
+                [0.0; 3]
+            }
+        })
         .collect();
 
     let mut photo_panel = srgb_image(width, height, &photo_linear);
@@ -284,13 +319,20 @@ fn fit_picture(
         ),
         &keys,
     );
+    let plus_background = if lit.background.is_some() {
+        ", plus the background"
+    } else {
+        ""
+    };
     let model_title = match &statistical {
         None => format!(
-            "Model: the water re-rendered with the fitted lights ({MODEL_SPP} rays per pixel)"
+            "Model: the water re-rendered with the fitted lights ({MODEL_SPP} rays per \
+             pixel){plus_background}"
         ),
         Some(w) => format!(
             "Model: the expected image of the fitted lights over waves of slope variance \
-             {:.2e} along, {:.2e} across (statistical water, {MODEL_SPP} rays per pixel)",
+             {:.2e} along, {:.2e} across (statistical water, {MODEL_SPP} rays per \
+             pixel){plus_background}",
             w.waves[0] + micro_variance(scene),
             w.waves[1] + micro_variance(scene)
         ),

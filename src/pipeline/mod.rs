@@ -23,6 +23,7 @@ pub use water_choice::{
     EXACT_MIN_EXPLAINED, FLAT_SHARE,
 };
 
+use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
 use crate::fitting::joint::{fit_joint_with, JointOptions, Uncertainty};
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
@@ -66,6 +67,9 @@ pub struct Lit {
     pub nothing_found: Option<(Input, String)>,
     /// Wall-clock seconds per stage, in the order run.
     pub timings: Vec<(String, f64)>,
+    /// The smooth background measured on the photo and taken off it before the lights were
+    /// fitted; `None` for a black night (or when no streak was found).
+    pub background: Option<Background>,
 }
 
 /// Which input a message is about.
@@ -148,9 +152,30 @@ pub fn fit(
             ),
         ));
     }
-    let segmentation = clock.time("streaks", || {
+    let mut segmentation = clock.time("streaks", || {
         streaks::extract_streaks(photo, &water, &settings.streaks)
     })?;
+    // A night that is not black: its smooth background is measured away from the streaks
+    // and taken off the photo, and the streaks are found again on what the lights alone lit.
+    let background = clock.time("background", || {
+        let pixels: Vec<u32> = segmentation
+            .streaks
+            .iter()
+            .flat_map(|s| s.pixels.iter().copied())
+            .collect();
+        Some(background::estimate(photo, &water, &pixels)).filter(|b| !b.is_black())
+    });
+    let cleaned;
+    let photo = match &background {
+        None => photo,
+        Some(b) => {
+            cleaned = photo.less(&b.pixels);
+            segmentation = clock.time("streaks without the background", || {
+                streaks::extract_streaks(&cleaned, &water, &settings.streaks)
+            })?;
+            &cleaned
+        }
+    };
     // A blank photo (one value over all the water: black, grey, all clipped) shows no
     // reflection, however the streak extraction reads it.
     let uniform = warnings::uniform_water(photo, &water);
@@ -203,6 +228,10 @@ pub fn fit(
         run.fit_lights(settings, &mut found)?
     };
     clock.add_fit(&found.timings);
+    if let Some(b) = &background {
+        let seen = found.seen();
+        b.restore_walls(scene, &water, &mut found.lights, &seen);
+    }
     let nothing_found = found
         .lights
         .is_empty()
@@ -228,6 +257,7 @@ pub fn fit(
         segmentation,
         nothing_found,
         timings: clock.timings,
+        background,
     })
 }
 
