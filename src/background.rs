@@ -25,6 +25,8 @@ pub struct Background {
     pub pixels: Vec<[f32; 3]>,
     /// Mean over the water's pixels.
     pub water_mean: [f32; 3],
+    /// The background's share of the light of the streaks' pixels (luminance, 0 to 1).
+    pub streak_share: f32,
     /// Cells measured (on the water and off it), out of all cells with pixels of a region.
     pub cells_measured: usize,
     /// Cells of either region in the photo.
@@ -82,8 +84,8 @@ fn cell_side(width: u32, height: u32) -> usize {
     (width.min(height) as usize / 30).max(8)
 }
 
-/// A pixel brighter than this many times the median pixel of its region (the water, or the
-/// rest) away from the streaks is a light's, not the background.
+/// A pixel brighter than this many times the background's level at it (at first, the median
+/// pixel of its region away from the streaks) is a light's, not the background.
 const BRIGHT: f32 = 2.5;
 
 /// Luminance of linear RGB (Rec. 709).
@@ -128,9 +130,21 @@ pub fn estimate(photo: &Photo, water: &[bool], streak_pixels: &[u32]) -> Backgro
             water_mean[c] += p[c] as f64;
         }
     }
+    let (mut under, mut total) = (0f64, 0f64);
+    for &i in streak_pixels {
+        if let (Some(b), Some(p)) = (pixels.get(i as usize), photo.radiance.get(i as usize)) {
+            under += luminance(*b) as f64;
+            total += luminance(*p) as f64;
+        }
+    }
     Background {
         width: photo.width,
         height: photo.height,
+        streak_share: if total > 0.0 {
+            (under / total).min(1.0) as f32
+        } else {
+            0.0
+        },
         pixels,
         water_mean: water_mean.map(|s| (s / water_count as f64) as f32),
         cells_measured,

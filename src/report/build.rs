@@ -1,8 +1,8 @@
 //! How the report is built from a fit ([`crate::pipeline::Lit`]) and the run's settings.
 
 use super::{
-    light_warnings, EdgeReport, EdgesReport, Files, LightReport, PlaneReport, Report, Settings,
-    SkippedStreak, Timing, UncertaintyReport, REPORT_VERSION,
+    light_warnings, BackgroundReport, EdgeReport, EdgesReport, Files, LightReport, PlaneReport,
+    Report, Settings, SkippedStreak, Timing, UncertaintyReport, REPORT_VERSION,
 };
 use crate::fitting::joint::{effective_samples, Uncertainty};
 use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, Skipped};
@@ -79,6 +79,12 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             water: scene.water.name.clone(),
         },
         water_model: lit.water_model.clone(),
+        background: lit.background.as_ref().map(|b| BackgroundReport {
+            water_mean: b.water_mean,
+            streak_share: b.streak_share,
+            cells_measured: b.cells_measured,
+            cells: b.cells,
+        }),
         lights: lit
             .lights
             .iter()

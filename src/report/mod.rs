@@ -33,6 +33,9 @@ pub struct Report {
     pub settings: Settings,
     /// The water model the lights were fitted with, why, and its slope estimate.
     pub water_model: crate::pipeline::WaterModelUsed,
+    /// The night's smooth background taken off the photo before the fit; `None` (null) for
+    /// a black night.
+    pub background: Option<BackgroundReport>,
     /// One entry per light written.
     pub lights: Vec<LightReport>,
     /// Streaks that gave no light, and why.
@@ -41,6 +44,19 @@ pub struct Report {
     pub timings: Vec<Timing>,
     /// Things the user should know.
     pub warnings: Vec<String>,
+}
+
+/// The smooth background (dim sky, lit facades, their reflections) measured on the photo.
+#[derive(Clone, Debug, Serialize)]
+pub struct BackgroundReport {
+    /// Mean radiance over the water's pixels, per channel.
+    pub water_mean: [f32; 3],
+    /// Its share of the light of the streaks' pixels (luminance, 0 to 1).
+    pub streak_share: f32,
+    /// Cells of the photo where it was measured, away from every light.
+    pub cells_measured: usize,
+    /// All cells (the water and the rest counted apart).
+    pub cells: usize,
 }
 
 /// Paths of the files involved.

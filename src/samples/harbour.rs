@@ -21,6 +21,7 @@ use super::gltf_doc::{CameraPose, Quad, Solid};
 use super::harbour_waves::harbour_spectrum;
 use super::water_surface::{mesh_rows, GridRow, RippleField, WaterMesh};
 use super::{SampleLight, SampleScene, SampleWater, Setup, PHOTO_SIZE};
+use crate::environment::Environment;
 
 /// The camera's position.
 pub const HARBOUR_CAMERA: [f64; 3] = [0.0, 2.0, 40.0];
@@ -252,6 +253,7 @@ pub fn catalogue(flat_gloss: f64) -> Vec<SampleScene> {
             photo_exr: None,
             setup: Setup::Harbour(framing),
             water,
+            environment: None,
         };
         scenes.push(scene(
             format!("harbour{sfx}.gltf"),
@@ -289,9 +291,35 @@ pub fn catalogue(flat_gloss: f64) -> Vec<SampleScene> {
                 Some(format!("harbour-{name}{sfx}.png")),
             ));
         }
+        if framing == Framing::InFrame {
+            let (_, description, lights) = &layouts()[0];
+            scenes.push(SampleScene {
+                environment: Some(NIGHT),
+                ..scene(
+                    "harbour-night-truth.gltf".into(),
+                    format!(
+                        "the harbour, {view}: {description}, under a dim sky (radiance {}) \
+                         that lights the facades (albedo {})",
+                        NIGHT.sky[0], NIGHT.albedo
+                    ),
+                    SampleWater::Waves,
+                    HARBOUR_GLOSS,
+                    lights.clone(),
+                    Some("harbour-night.png".into()),
+                )
+            });
+        }
     }
     scenes
 }
+
+/// The night of `harbour-night.png`: a grey sky 1/50 of the pair's lamps' brightest channel,
+/// which lights the facades of albedo 0.25 to about 1/400 of the lamps; the water reflects
+/// both.
+pub const NIGHT: Environment = Environment {
+    sky: [0.5; 3],
+    albedo: 0.25,
+};
 
 #[cfg(test)]
 mod tests {

@@ -137,6 +137,8 @@ pub struct SampleScene {
     pub setup: Setup,
     /// Which water.
     pub water: SampleWater,
+    /// The night the photo is rendered under: `None` for a black one.
+    pub environment: Option<crate::environment::Environment>,
 }
 
 /// The geometry a sample scene is set in.
@@ -231,6 +233,7 @@ pub fn catalogue() -> Vec<SampleScene> {
             photo_exr: None,
             setup: Setup::Paper,
             water: SampleWater::Waves,
+            environment: None,
         }
     };
     let gloss_samples = SAMPLE_GLOSSES.map(|gloss| {
@@ -515,6 +518,7 @@ pub fn render_photo(
         exposure: PHOTO_EXPOSURE,
         seed: 1,
         progress,
+        environment: spec.environment,
         ..Default::default()
     };
     crate::render::render(&scene, &options)
