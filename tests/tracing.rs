@@ -136,3 +136,44 @@ fn rays_along_shared_edges_never_pass_through_the_grid() {
         assert!(rays > 10_000);
     }
 }
+
+/// A ray leaving a large triangle from just above it never hits it: the reflected rays of a
+/// game scene's water (one quad kilometres wide) start a fraction of a millimetre above it.
+/// Single precision puts the computed distance of such a miss within about 1e-7 of the
+/// triangle's size of zero, on either side; a hit closer than that error bound is no hit.
+#[test]
+fn rays_leaving_a_large_quad_do_not_hit_it() {
+    for half in [50.0f32, 500.0, 5000.0, 50000.0] {
+        let quad = [
+            Vec3::new(-half, 0.0, -half),
+            Vec3::new(half, 0.0, -half),
+            Vec3::new(half, 0.0, half),
+            Vec3::new(-half, 0.0, half),
+        ];
+        let tracer = Tracer::new(&[
+            Triangle {
+                vertices: [quad[0], quad[1], quad[2]],
+            },
+            Triangle {
+                vertices: [quad[0], quad[2], quad[3]],
+            },
+        ]);
+        let mut rng = Rng::new(5, 0);
+        let mut false_hits = 0;
+        let count = 20_000;
+        for _ in 0..count {
+            let origin = Vec3::new(rng.next_f32() * 40.0 - 20.0, 1e-4, rng.next_f32() * -40.0);
+            let mut dir = random_unit(&mut rng);
+            dir.y = dir.y.abs().max(1e-3);
+            let dir = dir.normalize();
+            if tracer
+                .closest_hit(origin, dir, 0.0, f32::INFINITY)
+                .is_some()
+            {
+                false_hits += 1;
+            }
+        }
+        eprintln!("quad of half-size {half} m: {false_hits} of {count} rays leaving it hit it");
+        assert_eq!(false_hits, 0, "half-size {half} m");
+    }
+}
