@@ -13,6 +13,7 @@
 use crate::fitting::FittedLight;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
+use crate::streaks::Segmentation;
 
 /// A smooth background, in radiance per pixel.
 #[derive(Clone, Debug, PartialEq)]
@@ -210,6 +211,26 @@ fn measure(
         .map(|i| grids[usize::from(!water[i])].at((i % w) as f32, (i / w) as f32, side as f32))
         .collect();
     (pixels, cells_measured, cells)
+}
+
+/// The background of `photo` measured away from the streaks of `segmentation`, with the photo
+/// less it; `None` for a black night (nothing to take off).
+pub fn take_off(
+    photo: &Photo,
+    water: &[bool],
+    segmentation: &Segmentation,
+) -> Option<(Background, Photo)> {
+    let pixels: Vec<u32> = segmentation
+        .streaks
+        .iter()
+        .flat_map(|s| s.pixels.iter().copied())
+        .collect();
+    let background = estimate(photo, water, &pixels);
+    if background.is_black() {
+        return None;
+    }
+    let less = photo.less(&background.pixels);
+    Some((background, less))
 }
 
 /// Per-channel median (the upper one for an even count).

@@ -223,3 +223,58 @@ fn a_dim_sky_and_lit_facades_are_taken_off_before_the_fit() {
         );
     }
 }
+
+/// `segment` takes the night's background off as `fit` does, so it lists the streaks the fit
+/// fits: on `harbour-night.png`, two streaks, one per lamp, made of the fragments the fit's
+/// report names.
+#[test]
+fn segment_takes_the_background_off_as_fit_does() {
+    let dir = common::pipeline::sample_scenes();
+    let out = common::temp_dir("night-segment");
+    let (ok, stdout, stderr) = common::run_cli(&[
+        "segment".to_string(),
+        common::cli::arg(&dir.join("harbour.gltf")),
+        common::cli::arg(&sample_photo_path("harbour-night.png")),
+        "--exposure".into(),
+        "0.1".into(),
+        "--out-dir".into(),
+        common::cli::arg(&out),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("smooth background"), "{stderr}");
+    let streaks: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("streak "))
+        .collect();
+    assert_eq!(streaks.len(), 2, "{stdout}");
+    assert!(streaks[0].contains("(fragments 0, 1)"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `render --sky` takes one value or R,G,B of 0 or more, `--albedo` 0 to 1; anything else is
+/// refused at once with the accepted range and exit code 2, before anything is read.
+#[test]
+fn render_refuses_a_sky_or_albedo_out_of_range() {
+    let dir = common::pipeline::sample_scenes();
+    let out = common::temp_dir("night-render-args").join("x.png");
+    for (option, value, range) in [
+        ("--sky", "1,2", "R,G,B"),
+        ("--sky", "-0.5", "R,G,B"),
+        ("--albedo", "1.5", "from 0 to 1"),
+    ] {
+        let (code, _, stderr) = common::cli::run_cli_code(&[
+            "render".to_string(),
+            common::cli::arg(&dir.join("harbour.gltf")),
+            "-o".into(),
+            common::cli::arg(&out),
+            option.into(),
+            value.into(),
+        ]);
+        assert_eq!(code, 2, "{option} {value}: {stderr}");
+        assert!(
+            stderr.contains(range) && stderr.contains(option),
+            "{stderr}"
+        );
+        assert!(!out.exists());
+    }
+}

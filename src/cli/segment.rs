@@ -91,7 +91,24 @@ pub fn run(args: Args, out: &super::output::Output) -> streaklight::Result<()> {
         Error::NothingFound(m) => Error::NothingFound(format!("{}: {m}", args.photo.display())),
         other => other,
     };
-    let pieces = streaks::extract_streaks(&photo, &water, &params).map_err(in_photo)?;
+    let mut pieces = streaks::extract_streaks(&photo, &water, &params).map_err(in_photo)?;
+    // As `fit` does: a night's smooth background is taken off and the streaks found again.
+    let photo = match streaklight::background::take_off(&photo, &water, &pieces) {
+        None => photo,
+        Some((background, less)) => {
+            let m = background.water_mean;
+            out.info(&format!(
+                "measured the night's smooth background (mean on the water {:.4} {:.4} {:.4}, \
+                 {:.0} % of the streaks' light) and took it off the photo",
+                m[0],
+                m[1],
+                m[2],
+                100.0 * background.streak_share
+            ));
+            pieces = streaks::extract_streaks(&less, &water, &params).map_err(in_photo)?;
+            less
+        }
+    };
     pieces
         .require_streaks()
         .map_err(|e| Error::NothingFound(format!("{}: {e}", args.photo.display())))?;

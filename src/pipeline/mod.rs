@@ -157,23 +157,17 @@ pub fn fit(
     })?;
     // A night that is not black: its smooth background is measured away from the streaks
     // and taken off the photo, and the streaks are found again on what the lights alone lit.
-    let background = clock.time("background", || {
-        let pixels: Vec<u32> = segmentation
-            .streaks
-            .iter()
-            .flat_map(|s| s.pixels.iter().copied())
-            .collect();
-        Some(background::estimate(photo, &water, &pixels)).filter(|b| !b.is_black())
+    let taken_off = clock.time("background", || {
+        background::take_off(photo, &water, &segmentation)
     });
-    let cleaned;
-    let photo = match &background {
+    let (background, cleaned) = taken_off.unzip();
+    let photo = match &cleaned {
         None => photo,
-        Some(b) => {
-            cleaned = photo.less(&b.pixels);
+        Some(less) => {
             segmentation = clock.time("streaks without the background", || {
-                streaks::extract_streaks(&cleaned, &water, &settings.streaks)
+                streaks::extract_streaks(less, &water, &settings.streaks)
             })?;
-            &cleaned
+            less
         }
     };
     // A blank photo (one value over all the water: black, grey, all clipped) shows no
