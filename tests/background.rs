@@ -170,8 +170,10 @@ fn a_black_night_measures_black() {
 #[test]
 fn a_dim_sky_and_lit_facades_are_taken_off_before_the_fit() {
     let dir = common::pipeline::sample_scenes();
+    let debug = common::temp_dir("night-debug");
     let options = streaklight::convert::ConvertOptions {
         scene: dir.join("harbour.gltf"),
+        debug_dir: Some(debug.clone()),
         ..convert_options(
             dir,
             sample_photo_path("harbour-night.png"),
@@ -179,6 +181,17 @@ fn a_dim_sky_and_lit_facades_are_taken_off_before_the_fit() {
         )
     };
     let report = streaklight::convert::convert(&options).expect("fit").report;
+    // The debug pictures show the background measured (brightened: grey, not black, on the
+    // left panel's water) and the page shows the picture.
+    let html = std::fs::read_to_string(debug.join("index.html")).expect("index.html");
+    assert!(html.contains("src=\"background.png\""));
+    let picture = image::open(debug.join("background.png"))
+        .expect("background.png")
+        .to_rgb8();
+    let (w, h) = (picture.width(), picture.height());
+    let water = picture.get_pixel(w / 4, h - h / 8);
+    assert!(water[0] > 20 && water[0] == water[2], "{water:?}");
+    let _ = std::fs::remove_dir_all(&debug);
     assert_eq!(report.lights.len(), 2, "{:?}", report.warnings);
     for truth in &samples::harbour::layouts()[0].2 {
         let light = nearest(&report.lights, truth);
