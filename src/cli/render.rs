@@ -13,7 +13,8 @@ use super::scene_args::SceneArgs;
 pub const AFTER_HELP: &str = concat!(
     "Examples:\n  \
      streaklight render lit.gltf -o check.png --exposure 0.1\n  \
-     streaklight render lit.glb -o check.exr --width 1200 --spp 256 --nits-scale 683\n\n\
+     streaklight render lit.glb -o check.exr --width 1200 --spp 256 --nits-scale 683\n  \
+     streaklight render lit.gltf -o night.png --exposure 0.1 --sky 0.5 --albedo 0.25\n\n\
      Units: each pixel stores radiance times --exposure; a light's radiance is its intensity in \
      the file divided by --nits-scale. A .png is 8-bit sRGB, clipped at 1; an .exr keeps the \
      linear values.\n\n",
