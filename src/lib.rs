@@ -7,6 +7,7 @@
 //! |---|---|
 //! | 1. load the scene, bake transforms, build the BVH | [`scene_in`], [`tracing`] |
 //! | 2. decode the photo, mark clipped and water pixels | [`photo_in`], [`water_mask`] |
+//! | a night's smooth background, taken off the photo | [`background`] |
 //! | 3-6. superpixels, seeds, streaks, streak edges | [`streaks`] |
 //! | reflection model (§4) | [`optics`] |
 //! | how a pixel's reflection reaches a light's plane | [`water_model`] |
@@ -15,7 +16,7 @@
 //! | 10. write the lights back | [`scene_out`] |
 //! | files in, files out; the report | [`convert`], [`batch`], [`report`] |
 //! | pictures of every stage, and their page | [`debug_pictures`] |
-//! | rendering a lit scene (to make and check photos) | [`render`], [`photo_out`] |
+//! | rendering a lit scene (to make and check photos) | [`render`], [`environment`], [`photo_out`] |
 //! | sample scenes of the paper's setup | [`samples`] |
 //!
 //! # Fitting in memory
