@@ -214,12 +214,15 @@ fn measure(
 }
 
 /// The background of `photo` measured away from the streaks of `segmentation`, with the photo
-/// less it; `None` for a black night (nothing to take off).
+/// less it; `None` for a black night, or when no streak was found (nothing to fit on it).
 pub fn take_off(
     photo: &Photo,
     water: &[bool],
     segmentation: &Segmentation,
 ) -> Option<(Background, Photo)> {
+    if segmentation.streaks.is_empty() {
+        return None;
+    }
     let pixels: Vec<u32> = segmentation
         .streaks
         .iter()

@@ -155,11 +155,17 @@ pub fn fit(
     let mut segmentation = clock.time("streaks", || {
         streaks::extract_streaks(photo, &water, &settings.streaks)
     })?;
+    // A blank photo (one value over all the water: black, grey, all clipped) shows no
+    // reflection, however the streak extraction reads it.
+    let uniform = warnings::uniform_water(photo, &water);
     // A night that is not black: its smooth background is measured away from the streaks
     // and taken off the photo, and the streaks are found again on what the lights alone lit.
-    let taken_off = clock.time("background", || {
-        background::take_off(photo, &water, &segmentation)
-    });
+    let taken_off = match uniform {
+        Some(_) => None,
+        None => clock.time("background", || {
+            background::take_off(photo, &water, &segmentation)
+        }),
+    };
     let (background, cleaned) = taken_off.unzip();
     let photo = match &cleaned {
         None => photo,
@@ -170,9 +176,6 @@ pub fn fit(
             less
         }
     };
-    // A blank photo (one value over all the water: black, grey, all clipped) shows no
-    // reflection, however the streak extraction reads it.
-    let uniform = warnings::uniform_water(photo, &water);
     let observations: Vec<StreakObservation> = segmentation
         .streaks
         .iter()
