@@ -197,6 +197,14 @@ fn a_dim_sky_and_lit_facades_are_taken_off_before_the_fit() {
         let light = nearest(&report.lights, truth);
         assert_light_within("night", light, truth, 0.01, OfChannel(0.01));
     }
+    // The report, as written, holds the background in the shape its schema gives.
+    let value = serde_json::to_value(&report).expect("the report as JSON");
+    let errors: Vec<String> = common::json::schema_validator("report.schema.json")
+        .iter_errors(&value)
+        .map(|e| format!("{e} at {}", e.instance_path))
+        .collect();
+    assert!(errors.is_empty(), "{errors:?}");
+    assert!(value["background"].is_object());
     let measured = report.background.expect("a background");
     assert!(
         measured.streak_share > 0.0 && measured.streak_share < 0.2,
@@ -290,4 +298,33 @@ fn render_refuses_a_sky_or_albedo_out_of_range() {
         );
         assert!(!out.exists());
     }
+}
+
+/// `--no-background` fits the photo as it is: on `harbour-night.png` the report has no
+/// background, says it was not asked for, and the lamps' strong channels come out low by
+/// more than 5 % (measured: the orange lamp's red 11.6 %, the blue lamp's blue 13.8 %), which
+/// is what the background term removes.
+#[test]
+fn without_the_background_term_the_lamps_read_grey() {
+    let dir = common::pipeline::sample_scenes();
+    let mut options = streaklight::convert::ConvertOptions {
+        scene: dir.join("harbour.gltf"),
+        ..convert_options(
+            dir,
+            sample_photo_path("harbour-night.png"),
+            "night-raw.gltf",
+        )
+    };
+    options.fit.background = false;
+    let report = streaklight::convert::convert(&options).expect("fit").report;
+    assert!(report.background.is_none());
+    assert!(!report.settings.background);
+    let lights = samples::harbour::layouts().swap_remove(0).2;
+    let (orange, blue) = (&lights[0], &lights[1]);
+    let low = |truth: &samples::SampleLight, channel: usize| {
+        let light = nearest(&report.lights, truth);
+        1.0 - light.radiance[channel] / truth.radiance[channel]
+    };
+    assert!(low(orange, 0) > 0.05, "orange red {}", low(orange, 0));
+    assert!(low(blue, 2) > 0.05, "blue blue {}", low(blue, 2));
 }

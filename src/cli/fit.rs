@@ -135,6 +135,12 @@ pub struct Args {
     /// either way.
     #[arg(long)]
     pub no_direct_view: bool,
+    /// Fit the photo as it is: without this, a night's smooth background (a dim sky, lit
+    /// facades, their reflections in the water) is measured away from every streak and lamp
+    /// and taken off the photo before the lights are fitted (a black night is left as it
+    /// is); the report's `background` gives it.
+    #[arg(long)]
+    pub no_background: bool,
     /// How far in front of its wall each light is written, in metres, along the direction it
     /// emits: a light exactly in the wall's plane is shadowed by the wall in renderers that
     /// trace shadow rays (Blender's Cycles among them). The report records it. 0 or more;
@@ -190,6 +196,7 @@ impl Args {
                 "statistical" => WaterChoice::Statistical,
                 _ => WaterChoice::Auto,
             },
+            background: !self.no_background,
         })
     }
 }

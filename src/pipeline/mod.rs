@@ -162,6 +162,7 @@ pub fn fit(
     // and taken off the photo, and the streaks are found again on what the lights alone lit.
     let taken_off = match uniform {
         Some(_) => None,
+        None if !settings.background => None,
         None => clock.time("background", || {
             background::take_off(photo, &water, &segmentation)
         }),

@@ -27,12 +27,16 @@ pub struct FitSettings {
     pub method: Method,
     /// Which model of the water the fit inverts (method §10).
     pub water: WaterChoice,
+    /// Whether a night's smooth background (a dim sky, lit facades, their reflections) is
+    /// measured away from the lights and taken off the photo before they are fitted
+    /// ([`crate::background`]); a black night is left as it is either way.
+    pub background: bool,
 }
 
 impl Default for FitSettings {
     /// The defaults of `streaklight fit`: [`DEFAULT_SAMPLES`] samples, seed 1, the paper's
     /// G = 1, the default streak extraction, the joint method with the scene's gloss, the
-    /// exact water model.
+    /// water model chosen from the photo, the night's background taken off.
     fn default() -> Self {
         FitSettings {
             samples: DEFAULT_SAMPLES,
@@ -41,6 +45,7 @@ impl Default for FitSettings {
             streaks: StreakParams::default(),
             method: Method::default(),
             water: WaterChoice::default(),
+            background: true,
         }
     }
 }

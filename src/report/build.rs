@@ -75,6 +75,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             nits_scale: run.nits_scale,
             light_offset: None,
             method: settings.method.name().into(),
+            background: settings.background,
             camera: scene.camera.name.clone(),
             water: scene.water.name.clone(),
         },

@@ -106,6 +106,8 @@ pub struct Settings {
     pub light_offset: Option<f64>,
     /// Fitting method.
     pub method: String,
+    /// Whether a night's smooth background was to be taken off (`--no-background` says no).
+    pub background: bool,
     /// Camera node used.
     pub camera: String,
     /// Water node used.
