@@ -6,8 +6,8 @@
 //! It is measured where no light reaches: the photo is cut into cells, and in each cell the
 //! pixels away from every streak and every bright pixel give a per-channel median, the water
 //! and the rest of the photo apart (the horizon is an edge of the background, not a slope of
-//! it). Cells the lights cover take the mean of their measured neighbours, and each pixel
-//! reads its region's cells bilinearly. The median ignores what little of a streak's faint
+//! it). Cells the lights cover are interpolated along their row from the measured ones, and
+//! each pixel reads its region's cells bilinearly. The median ignores what little of a streak's faint
 //! tail is left in a cell, so a black night measures black.
 
 use crate::fitting::FittedLight;
@@ -294,12 +294,33 @@ impl CellGrid {
         }
     }
 
-    /// Gives every cell without a value the mean of its valued neighbours (8-connected), ring
-    /// by ring outwards from the measured ones; black when nothing was measured.
+    /// Gives every cell without a value one: along its row first, linearly between the
+    /// nearest measured cells on either side (or the one side's), since the background on
+    /// the water varies mostly with the view's angle to it, that is down the rows (the
+    /// Fresnel factor); then, in rows with no measured cell, the mean of its valued
+    /// neighbours (8-connected), ring by ring; black when nothing was measured.
     fn fill(&mut self) {
         if self.value.iter().all(Option::is_none) {
             self.value.iter_mut().for_each(|v| *v = Some([0.0; 3]));
             return;
+        }
+        for cy in 0..self.ch {
+            let row: Vec<Option<[f32; 3]>> = self.value[cy * self.cw..(cy + 1) * self.cw].to_vec();
+            for cx in 0..self.cw {
+                if row[cx].is_some() {
+                    continue;
+                }
+                let left = (0..cx).rev().find_map(|x| row[x].map(|v| (x, v)));
+                let right = (cx + 1..self.cw).find_map(|x| row[x].map(|v| (x, v)));
+                self.value[cy * self.cw + cx] = match (left, right) {
+                    (Some((xl, vl)), Some((xr, vr))) => {
+                        let t = (cx - xl) as f32 / (xr - xl) as f32;
+                        Some([0, 1, 2].map(|c| vl[c] + (vr[c] - vl[c]) * t))
+                    }
+                    (Some((_, v)), None) | (None, Some((_, v))) => Some(v),
+                    (None, None) => None,
+                };
+            }
         }
         while self.value.iter().any(Option::is_none) {
             let mut next = self.value.clone();
