@@ -68,7 +68,8 @@ pub struct Lit {
     /// Wall-clock seconds per stage, in the order run.
     pub timings: Vec<(String, f64)>,
     /// The smooth background measured on the photo and taken off it before the lights were
-    /// fitted; `None` for a black night (or when no streak was found).
+    /// fitted; `None` for a black night, a blank photo, a photo without streaks, or when
+    /// [`FitSettings::background`] is off.
     pub background: Option<Background>,
 }
 
