@@ -60,3 +60,38 @@ pub fn assert_light_within(
         );
     }
 }
+
+/// Asserts every error of `light` the report gives a sigma for (its constrained edges and
+/// every radiance channel) within `bound` of those sigmas.
+pub fn assert_within_sigmas(light: &LightReport, truth: &SampleLight, bound: f64) {
+    let u = light
+        .uncertainty
+        .as_ref()
+        .unwrap_or_else(|| panic!("{}: no uncertainties", truth.name));
+    let edges = truth.edge_errors(light.corner_left_bottom, light.width, light.height);
+    let sizes = [truth.width, truth.width, truth.height, truth.height];
+    for (k, sd) in [u.left, u.right, u.bottom, u.top].iter().enumerate() {
+        if let Some(sd) = sd {
+            let metres = edges[k] * sizes[k];
+            eprintln!("{} edge {k}: {metres:.4} m, sigma {sd:.4} m", truth.name);
+            assert!(
+                metres.abs() < bound * sd,
+                "{} edge {k}: {metres} m against sigma {sd}",
+                truth.name
+            );
+        }
+    }
+    for ch in 0..3 {
+        let e = light.radiance[ch] - truth.radiance[ch];
+        eprintln!(
+            "{} channel {ch}: {e:.4}, sigma {:.4}",
+            truth.name, u.radiance[ch]
+        );
+        assert!(
+            e.abs() < bound * u.radiance[ch],
+            "{} channel {ch}: {e} against sigma {}",
+            truth.name,
+            u.radiance[ch]
+        );
+    }
+}

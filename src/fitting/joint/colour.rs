@@ -1,4 +1,5 @@
-//! A light's colour from the pixels that show it unclipped, for the channels the photo clips.
+//! A light's colour from the pixels that show it alone and unclipped, for the channels the
+//! photo clips and the channels other lights crowd.
 //!
 //! The radiances are least-squares solves per channel in which a clipped channel is only a
 //! lower bound (`cost`). Where a light clips one channel of the photo and not another (an
@@ -27,9 +28,10 @@ const OTHERS_SHARE: f64 = 0.05;
 const MIN_PIXELS: usize = 16;
 
 /// Sets the radiance of every channel a light's pixels clip more often than its best-told
-/// channel from that channel and the light's colour in its unclipped pixels (module doc).
-/// Lights with no channel clipped, or too few unclipped pixels, are left as they are.
-pub(super) fn colour_from_unclipped(problem: &Problem, st: &mut State) {
+/// channel, and of every channel other lights crowd ([`crowded`]), from the best-told channel
+/// and the light's colour in the pixels it lights alone, unclipped (module doc). Lights with
+/// no such channel, or too few such pixels, are left as they are.
+pub(super) fn colour_from_own_pixels(problem: &Problem, st: &mut State) {
     for k in 0..st.rects.len() {
         let radiance = st.radiance[k];
         // Per channel: how many of the pixels this light lights are clipped in it.
@@ -37,6 +39,8 @@ pub(super) fn colour_from_unclipped(problem: &Problem, st: &mut State) {
         let mut clipped = [0usize; 3];
         // Per channel: the light's own part of the photo over its unclipped pixels.
         let mut sums = [0f64; 3];
+        // Per channel, over every pixel it lights: its own model and the other lights'.
+        let (mut own_total, mut rest_total) = ([0f64; 3], [0f64; 3]);
         let mut clean = 0usize;
         for i in 0..problem.n() {
             let c = st.coef[k][i] as f64;
@@ -45,6 +49,10 @@ pub(super) fn colour_from_unclipped(problem: &Problem, st: &mut State) {
             }
             let own = radiance.map(|l| l * c);
             let (rest, _) = problem.others(st, k, i);
+            for ch in 0..3 {
+                own_total[ch] += own[ch];
+                rest_total[ch] += rest[ch];
+            }
             if (0..3).any(|ch| rest[ch] > OTHERS_SHARE * (own[ch] + rest[ch])) {
                 continue;
             }
@@ -60,7 +68,19 @@ pub(super) fn colour_from_unclipped(problem: &Problem, st: &mut State) {
                 }
             }
         }
-        if lit == 0 || clean < MIN_PIXELS || clipped.iter().all(|&n| n == clipped[0]) {
+        let share = [0, 1, 2].map(|ch| {
+            let total = own_total[ch] + rest_total[ch];
+            if total > 0.0 {
+                rest_total[ch] / total
+            } else {
+                0.0
+            }
+        });
+        if lit == 0
+            || clean < MIN_PIXELS
+            || (clipped.iter().all(|&n| n == clipped[0])
+                && (0..3).all(|a| (0..3).all(|b| !crowded(share, a, b))))
+        {
             continue;
         }
         let Some(best) = (0..3)
@@ -74,9 +94,17 @@ pub(super) fn colour_from_unclipped(problem: &Problem, st: &mut State) {
             continue;
         };
         for ch in 0..3 {
-            if clipped[ch] > clipped[best] {
+            if clipped[ch] > clipped[best] || crowded(share, ch, best) {
                 st.radiance[k][ch] = radiance[best] * (sums[ch] / sums[best]).max(0.0);
             }
         }
     }
+}
+
+/// Whether other lights crowd channel `ch` of a light compared with its channel `best`:
+/// their share of the model over the pixels it lights is above [`OTHERS_SHARE`] in `ch` and
+/// more than twice their share in `best`. Lights of one colour share every channel alike, so
+/// a white light under another keeps its least-squares radiance.
+fn crowded(share: [f64; 3], ch: usize, best: usize) -> bool {
+    share[ch] > OTHERS_SHARE && share[ch] > 2.0 * share[best]
 }

@@ -71,7 +71,7 @@
 //! | `control_variate` | the lobe Gaussian |
 //! | `problem` | the fitted pixels with their samples, a fit's state |
 //! | `cost` | the cost, the coefficients' noise, the radiances' solve |
-//! | `colour` | a clipped channel's radiance from the light's colour where it is unclipped |
+//! | `colour` | a clipped or crowded channel's radiance from the light's colour where it is alone |
 //! | `ramps` | a coefficient at every grid position of one edge |
 //! | `profile` | the cost at every grid position of one edge |
 //! | `descent` | coordinate descent and its windows |
@@ -585,8 +585,8 @@ pub fn fit_joint_with(
     })
 }
 
-/// The last steps of a fit: the channels a light clips from its colour in the pixels it does
-/// not (`colour`), then the uncertainties, the repeats' `spread` (one per light, where there
+/// The last steps of a fit: the channels a light clips, or other lights crowd, from its colour
+/// in the pixels it lights alone (`colour`), then the uncertainties, the repeats' `spread` (one per light, where there
 /// are several repeats) added to the curvature's.
 fn finish(
     problem: &Problem,
@@ -594,7 +594,7 @@ fn finish(
     extents: &[Option<Rect>],
     spread: Option<&[([f32; 4], [f32; 3])]>,
 ) -> Vec<Uncertainty> {
-    colour::colour_from_unclipped(problem, st);
+    colour::colour_from_own_pixels(problem, st);
     let mut uncertainty = uncertainties(problem, st, extents);
     for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
         u.edges = EdgeSide::ALL.map(|e| u.edges[e].map(|sd| sd.hypot(edges[e as usize])));
