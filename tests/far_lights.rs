@@ -175,7 +175,11 @@ fn the_harbour_pair_out_of_frame_within_its_sigmas() {
     })
     .expect("fit")
     .report;
-    assert_eq!(report.water_model.model, "exact", "{:?}", report.water_model);
+    assert_eq!(
+        report.water_model.model, "exact",
+        "{:?}",
+        report.water_model
+    );
     assert_eq!(report.lights.len(), 2, "{:?}", report.warnings);
     let layouts = harbour::layouts();
     let truths = &layouts.iter().find(|l| l.0 == "pair").expect("the pair").2;
