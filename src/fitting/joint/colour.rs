@@ -76,11 +76,9 @@ pub(super) fn colour_from_own_pixels(problem: &Problem, st: &mut State) {
                 0.0
             }
         });
-        if lit == 0
-            || clean < MIN_PIXELS
-            || (clipped.iter().all(|&n| n == clipped[0])
-                && (0..3).all(|a| (0..3).all(|b| !crowded(share, a, b))))
-        {
+        // A light with no channel clipped more than another and none crowded is left as it
+        // is by the loop below.
+        if lit == 0 || clean < MIN_PIXELS {
             continue;
         }
         let Some(best) = (0..3)
