@@ -159,3 +159,75 @@ fn a_small_flat_scene_at_the_defaults() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The statistical model's expected image against a photo of one wave field, with the true
+/// lights and the waves' slope variances taken from their spectrum (not fitted): the harbour
+/// pair out of frame (`harbour-pair-above.png`, rendered over the scene's own mesh, 64 rays
+/// per pixel). Per light (each in its own half of the photo, read in its strongest channel):
+/// the reflected flux within 4 % of the photo's and the streak's centroid within 4 pixels.
+/// Measured when this was written: flux +0.0 % and +2.7 %, centroids within 0.7 and 2.9
+/// pixels. The streaks' lengths along the view (the rows' standard deviation) are where one
+/// realisation of the waves departs from the expectation: the orange light's is 4.6 % longer
+/// in the model, the blue light's 29 % longer, so a fit from the reflections alone, which
+/// trades the lights' heights against the slope variance along the view, cannot recover both
+/// heights (docs/method.md §10). The test holds that too, as the reason the out-of-frame
+/// statistical fits are not yet usable: if a model change made the blue streak's expected
+/// length match, that reason would have to be looked at again.
+#[test]
+fn the_expected_image_holds_the_photos_flux_and_centroids() {
+    use streaklight::render::{render, RenderOptions};
+    use streaklight::samples::harbour_waves::harbour_spectrum;
+    use streaklight::water_model::StatisticalSurface;
+
+    let scene = sample_scene("harbour-pair-above-truth.gltf", None);
+    let photo = sample_photo("harbour-pair-above.png");
+    let (w, h) = (photo.width, photo.height);
+    let spectrum = harbour_spectrum();
+    let water = StatisticalSurface {
+        surface: water_statistics(&scene, w, h).unwrap().surface,
+        waves: [
+            spectrum.rms_slope_along.powi(2) as f32,
+            spectrum.rms_slope_across.powi(2) as f32,
+        ],
+    };
+    let model = render(
+        &scene,
+        &RenderOptions {
+            width: w,
+            height: h,
+            samples_per_pixel: 64,
+            water: Some(&water),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    // Flux, centroid (column, row) and the rows' standard deviation of channel `ch` over
+    // the columns `columns`.
+    let moments = |img: &[[f32; 3]], ch: usize, columns: std::ops::Range<u32>| {
+        let (mut s, mut sx, mut sy, mut syy) = (0.0f64, 0.0, 0.0, 0.0);
+        for (i, p) in img.iter().enumerate() {
+            let (x, y) = ((i as u32 % w) as f64, (i as u32 / w) as f64);
+            if columns.contains(&(i as u32 % w)) {
+                let v = p[ch] as f64;
+                s += v;
+                sx += v * x;
+                sy += v * y;
+                syy += v * y * y;
+            }
+        }
+        let (cx, cy) = (sx / s, sy / s);
+        (s, cx, cy, (syy / s - cy * cy).sqrt())
+    };
+    let mut lengths = Vec::new();
+    for (name, ch, columns) in [("orange", 0, 0..w / 2), ("blue", 2, w / 2..w)] {
+        let p = moments(&photo.radiance, ch, columns.clone());
+        let m = moments(&model.pixels, ch, columns);
+        let flux = m.0 / p.0 - 1.0;
+        assert!(flux.abs() < 0.04, "{name}: flux {:+.1} %", 100.0 * flux);
+        let off = (m.1 - p.1).hypot(m.2 - p.2);
+        assert!(off < 4.0, "{name}: centroid {off:.1} pixels off");
+        lengths.push(m.3 / p.3 - 1.0);
+    }
+    assert!(lengths[0].abs() < 0.1, "orange length {:+.3}", lengths[0]);
+    assert!(lengths[1] > 0.15, "blue length {:+.3}", lengths[1]);
+}
