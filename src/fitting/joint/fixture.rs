@@ -89,6 +89,37 @@ impl Table3Light0 {
     }
 }
 
+impl Table3Light0 {
+    /// A problem over the traced pixels (`planes`, `inv_samples` as [`Self::trace`] gives
+    /// them) whose photo is what light0 over `truth` gives, at radiance 1, 0.6 and 0.3 per
+    /// channel: a photo the model reproduces up to its samples' noise. No pixel is clipped.
+    pub(super) fn problem(
+        &self,
+        planes: Vec<PlaneSamples>,
+        inv_samples: f32,
+        truth: &Rect,
+    ) -> super::problem::Problem {
+        let n = self.pixels.len();
+        let obs = (0..n)
+            .map(|i| {
+                let c = planes[0].coefficient(i, truth, inv_samples).0;
+                [c, 0.6 * c, 0.3 * c]
+            })
+            .collect();
+        super::problem::Problem {
+            width: self.width,
+            pixel_ids: self.pixels.clone(),
+            obs,
+            clipped: vec![false; n],
+            clipped_channels: vec![[false; 3]; n],
+            planes,
+            set_origin: vec![0],
+            inv_samples,
+            first_direct: n,
+        }
+    }
+}
+
 /// A light on `plane` over `rect` explaining streak `streak`, radiance 1, every edge
 /// constrained: a start as the joint fit receives one.
 pub(super) fn start_light(

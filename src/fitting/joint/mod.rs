@@ -40,7 +40,8 @@
 //! The model is linear in the radiances: given the rectangles they are a nonnegative least
 //! squares solve per channel (`cost`). The edges are found by coordinate descent
 //! (`descent`) where each 1D step evaluates the cost on a whole grid of edge positions in
-//! one pass over the samples (prefix sums over binned samples: `ramps`, `profile`), with
+//! one pass over the samples near it (`near`; prefix sums over binned samples: `ramps`,
+//! `profile`; polynomials where the coefficients are smooth: `pieces`), with
 //! that light's radiance re-optimised in closed form at every grid point, so a far-off start
 //! (the paper's estimate can be metres off) is pulled in by a global 1D search rather than a
 //! local step. The grid then shrinks around the best position until it is finer than a
@@ -67,12 +68,14 @@
 //! | `direct_start` | starts far from a light's direct image moved onto it, fragments merged |
 //! | `lamp_starts` | one start per lamp whose reflections share a streak with another's |
 //! | `samples` | tracing and storing the plane samples, a coefficient from them |
+//! | `near` | the samples a moving edge can change, found by bisection |
 //! | `kernel` | each sample's cell and kernel |
 //! | `control_variate` | the lobe Gaussian |
 //! | `problem` | the fitted pixels with their samples, a fit's state |
 //! | `cost` | the cost, the coefficients' noise, the radiances' solve |
 //! | `colour` | a clipped or crowded channel's radiance from the light's colour where it is alone |
 //! | `ramps` | a coefficient at every grid position of one edge |
+//! | `pieces` | a profile's sums as polynomials over runs of its grid |
 //! | `profile` | the cost at every grid position of one edge |
 //! | `descent` | coordinate descent and its windows |
 //! | `optimise` | descent, split, boundary search, descent; repeats' replay |
@@ -105,7 +108,9 @@ pub(crate) mod direct_start;
 mod fixture;
 mod kernel;
 mod lamp_starts;
+mod near;
 mod optimise;
+mod pieces;
 mod problem;
 mod profile;
 mod ramps;
@@ -197,6 +202,10 @@ impl JointOptions<'_> {
 /// Default lobe samples per pixel of the joint fit.
 pub const DEFAULT_JOINT_SAMPLES: u32 = 72;
 
+/// The most lobe samples per pixel the joint fit takes: a pixel's stored samples are indexed
+/// in 16 bits (`samples::PlaneSamples::by_v`), and `effective_samples` of this is 32768.
+pub const MAX_JOINT_SAMPLES: u32 = 32_768;
+
 /// The result of a joint fit.
 #[derive(Clone, Debug)]
 pub struct JointOutcome {
@@ -275,6 +284,12 @@ pub fn fit_joint_with(
         return Err(Error::Usage(
             "the joint fit needs at least one sample per pixel".into(),
         ));
+    }
+    if options.samples > MAX_JOINT_SAMPLES {
+        return Err(Error::Usage(format!(
+            "the joint fit takes at most {MAX_JOINT_SAMPLES} samples per pixel, not {}",
+            options.samples
+        )));
     }
     if options.repeats == 0 {
         return Err(Error::Usage(

@@ -92,9 +92,9 @@ impl Problem {
                         0.0,
                     );
                 }
-                let (p, p_dev) = samples.coefficient(i, plus, self.inv_samples);
-                let (m, m_dev) = samples.coefficient(i, minus, self.inv_samples);
-                ((p - m) / (2.0 * h), (p_dev - m_dev) / (2.0 * h))
+                let (dc, dd) = samples.coefficient_change(i, minus, plus, self.inv_samples);
+                let h = 2.0 * h as f64;
+                ((dc / h) as f32, (dd / h) as f32)
             })
             .unzip()
     }
@@ -113,7 +113,10 @@ impl Problem {
             .enumerate()
             .for_each(|(i, (c, v))| {
                 if reaches(&samples.bbox[i], strip) {
-                    (*c, *v) = samples.coefficient(i, &rect, inv);
+                    // From the samples near the edges that moved (in f64; the f32 rounding
+                    // each move adds is far below the samples' noise).
+                    let (dc, dv) = samples.coefficient_change(i, &old, &rect, inv);
+                    (*c, *v) = ((*c as f64 + dc) as f32, (*v as f64 + dv) as f32);
                 } else {
                     // Only the Gaussian can reach the strip: update its exact mass, without
                     // going through the samples (in f64; the f32 rounding this repeats is

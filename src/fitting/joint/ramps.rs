@@ -8,6 +8,7 @@
 //! at each grid point.
 
 use super::kernel::{kernel_coverage, POINT_CELL};
+use super::near::Near;
 use super::samples::PlaneSamples;
 use crate::fitting::rect::Rect;
 use crate::fitting::EdgeSide;
@@ -57,7 +58,7 @@ impl PlaneSamples {
         dev: &mut [f32],
     ) {
         ramps.clear(coef.len());
-        self.add_to_ramps(self.range(i), &EdgeFrame::new(rect, side), ramps);
+        self.add_to_ramps(Near::Run(self.range(i)), &EdgeFrame::new(rect, side), ramps);
         ramps.values(coef, dev);
         let g = &self.gauss[i];
         for (j, (c, d)) in coef.iter_mut().zip(dev.iter_mut()).enumerate() {
@@ -71,22 +72,23 @@ impl PlaneSamples {
         }
     }
 
-    /// Adds the samples `range` to `ramps` as functions of the edge `frame` describes (each
+    /// Adds the samples `ids` to `ramps` as functions of the edge `frame` describes (each
     /// sample's kernel, its share across the edge's axis inside the rectangle counted);
     /// returns whether any counts anywhere on the ramps' grid.
     pub(super) fn add_to_ramps(
         &self,
-        range: std::ops::Range<usize>,
+        ids: Near<'_>,
         frame: &EdgeFrame,
         ramps: &mut EdgeRamps,
     ) -> bool {
         let mut any = false;
-        for (((p, h), &w), &half) in self.points[range.clone()]
-            .iter()
-            .zip(&self.cells[range.clone()])
-            .zip(&self.weights[range.clone()])
-            .zip(&self.halves[range])
-        {
+        for q in ids {
+            let (p, h, w, half) = (
+                self.points[q],
+                self.cells[q],
+                self.weights[q],
+                self.halves[q],
+            );
             let (x, hx, y, hy) = if frame.along_u {
                 (p.x, h.x, p.y, h.y)
             } else {
@@ -111,22 +113,26 @@ impl PlaneSamples {
 
 /// One pixel's coefficient as a function of an edge's position on the grid
 /// `t_j = lo + j step`. Each sample's kernel contributes a piecewise linear function of t: a
-/// constant and ramps `s max(t - kink, 0)`. A ramp is accumulated at the first grid point
-/// past its kink as its slope `s` and `s kink`; after prefix sums the value at `t_j` is
+/// constant and ramps `s max(t - kink, 0)`. A ramp is recorded at the first grid point past
+/// its kink as its slope `s` and `s kink`; summed up to `j`, the value at `t_j` is
 /// `constant + t_j sum s - sum s kink`, exact and one pass over the samples. Kept for the
-/// absolute weights (the coefficient) and the signed ones (its half-difference).
+/// absolute weights (the coefficient) and the signed ones (its half-difference). The ramps
+/// are kept as a list, not per grid point: a pixel has a few near a narrow window, and the
+/// value is linear between them ([`Self::for_each_piece`]).
 pub(super) struct EdgeRamps {
     lo: f64,
     /// The last grid point.
     hi: f64,
     step: f64,
     inv_step: f64,
+    grid: usize,
     pub(super) constant: [f64; 2],
     /// Whether any ramp starts at or before the last grid point (otherwise the value is
     /// `constant` everywhere).
     pub(super) kinked: bool,
-    slope: Vec<[f64; 2]>,
-    slope_kink: Vec<[f64; 2]>,
+    /// Per ramp: the grid point it is recorded at, its slope and its slope times its kink
+    /// (absolute and signed).
+    kinks: Vec<(usize, [f64; 2], [f64; 2])>,
 }
 
 impl EdgeRamps {
@@ -136,20 +142,18 @@ impl EdgeRamps {
             hi: lo as f64 + (grid - 1) as f64 * step as f64,
             step: step as f64,
             inv_step: 1.0 / step as f64,
+            grid,
             constant: [0.0; 2],
             kinked: false,
-            slope: vec![[0.0; 2]; grid],
-            slope_kink: vec![[0.0; 2]; grid],
+            kinks: Vec::new(),
         }
     }
 
     pub(super) fn clear(&mut self, grid: usize) {
         self.constant = [0.0; 2];
         self.kinked = false;
-        self.slope.clear();
-        self.slope.resize(grid, [0.0; 2]);
-        self.slope_kink.clear();
-        self.slope_kink.resize(grid, [0.0; 2]);
+        self.kinks.clear();
+        self.grid = grid;
     }
 
     pub(super) fn constant(&mut self, abs: f64, signed: f64) {
@@ -161,13 +165,54 @@ impl EdgeRamps {
         let f = (at - self.lo) * self.inv_step;
         // Truncation is the floor here (f >= 0), without a call to libm's floor.
         let j = if f < 0.0 { 0 } else { f as usize + 1 };
-        if let (Some(s), Some(sk)) = (self.slope.get_mut(j), self.slope_kink.get_mut(j)) {
+        if j < self.grid {
             self.kinked = true;
-            s[0] += abs;
-            s[1] += signed;
-            sk[0] += abs * at;
-            sk[1] += signed * at;
+            self.kinks.push((j, [abs, signed], [abs * at, signed * at]));
         }
+    }
+
+    /// Calls `piece(j0, j1, intercept, slope)` for each run of grid points `j0..j1` over
+    /// which the value (absolute, signed) is `intercept + slope t_j`, in order, the runs
+    /// covering the whole grid.
+    pub(super) fn for_each_piece(
+        &mut self,
+        mut piece: impl FnMut(usize, usize, [f64; 2], [f64; 2]),
+    ) {
+        // Unstable but deterministic: the same ramps give the same order on every run.
+        self.kinks.sort_unstable_by_key(|k| k.0);
+        let (mut s, mut sk) = ([0f64; 2], [0f64; 2]);
+        let mut from = 0;
+        let mut next = 0;
+        while from < self.grid {
+            while next < self.kinks.len() && self.kinks[next].0 <= from {
+                let (_, slope, slope_kink) = self.kinks[next];
+                for c in 0..2 {
+                    s[c] += slope[c];
+                    sk[c] += slope_kink[c];
+                }
+                next += 1;
+            }
+            let to = self.kinks.get(next).map_or(self.grid, |k| k.0);
+            piece(
+                from,
+                to,
+                [self.constant[0] - sk[0], self.constant[1] - sk[1]],
+                s,
+            );
+            from = to;
+        }
+    }
+
+    /// The coefficient's sum of weights (absolute, signed) at every grid point.
+    pub(super) fn values(&mut self, abs: &mut [f32], signed: &mut [f32]) {
+        let (lo, step) = (self.lo, self.step);
+        self.for_each_piece(|j0, j1, intercept, slope| {
+            for j in j0..j1 {
+                let t = lo + j as f64 * step;
+                abs[j] = (intercept[0] + t * slope[0]) as f32;
+                signed[j] = (intercept[1] + t * slope[1]) as f32;
+            }
+        });
     }
 
     /// Adds a sample's kernel of half-width h at x along the edge's axis ([`kernel_coverage`];
@@ -245,20 +290,6 @@ impl EdgeRamps {
             self.kink(b, -abs * slope, -signed * slope);
         }
         true
-    }
-
-    /// The coefficient's sum of weights (absolute, signed) at every grid point.
-    pub(super) fn values(&self, abs: &mut [f32], signed: &mut [f32]) {
-        let (mut s, mut sk) = ([0f64; 2], [0f64; 2]);
-        for (j, (a, b)) in abs.iter_mut().zip(signed.iter_mut()).enumerate() {
-            for c in 0..2 {
-                s[c] += self.slope[j][c];
-                sk[c] += self.slope_kink[j][c];
-            }
-            let t = self.lo + j as f64 * self.step;
-            *a = (self.constant[0] + t * s[0] - sk[0]) as f32;
-            *b = (self.constant[1] + t * s[1] - sk[1]) as f32;
-        }
     }
 }
 

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 
 use super::control_variate::{self, LobeGaussian};
 use super::direct::{direct_hits, Hit, DIRECT_RAYS};
-use super::kernel::{cell_half_extents, kernel_coverage, LobeNeighbours};
+use super::kernel::{cell_half_extents, kernel_coverage, LobeNeighbours, POINT_CELL};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::optics::{compact_strata, ReflectionModel};
@@ -56,6 +56,13 @@ pub(super) struct PlaneSamples {
     /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1); 0
     /// for a direct pixel's samples, whose coefficient is exact (no noise to measure).
     pub(super) halves: Vec<f32>,
+    /// Per sample, its pixel's samples in order of v, as offsets from the pixel's first
+    /// sample (each pixel's samples are stored in order of u): with both orders, the samples
+    /// near an edge of either axis are found by bisection ([`Self::near`]).
+    pub(super) by_v: Vec<u16>,
+    /// Per pixel, the largest reach of its samples' kernels along u and along v (at least
+    /// [`POINT_CELL`]).
+    pub(super) reach: Vec<Vec2>,
     /// Per pixel, the control variate ([`LobeGaussian::NONE`] without).
     pub(super) gauss: Vec<LobeGaussian>,
     /// The smallest width and height a light on this plane may take ([`smallest_light`]).
@@ -180,7 +187,8 @@ pub(super) fn trace_samples(
             let mut rng = Rng::new(seed, stream);
             let (x, y) = (pixel % width, pixel / width);
             if index >= first_direct {
-                let hits = direct_hits(scene, planes, roi, x, y, width, height, direct_weight);
+                let mut hits = direct_hits(scene, planes, roi, x, y, width, height, direct_weight);
+                hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
                 return (hits, vec![LobeGaussian::NONE; planes.len()]);
             }
             let mut hits = Vec::new();
@@ -314,6 +322,9 @@ pub(super) fn trace_samples(
             for g in gauss.iter_mut() {
                 g.mass *= drew;
             }
+            // Stored in order of u (see `PlaneSamples::near`); stable, so that the order is
+            // the same on every run.
+            hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
             // Every pixel's hits stay alive until all are stored: without the slack a
             // growing vector keeps (up to as much again), the joint fit peaks lower.
             hits.shrink_to_fit();
@@ -340,6 +351,8 @@ pub(super) fn trace_samples(
                 cells: Vec::with_capacity(n),
                 weights: Vec::with_capacity(n),
                 halves: Vec::with_capacity(n),
+                by_v: Vec::with_capacity(n),
+                reach: Vec::with_capacity(pixels.len()),
                 gauss: Vec::with_capacity(pixels.len()),
                 min_size: Vec2::ZERO,
                 distance: planes[k].camera_distance(),
@@ -357,10 +370,18 @@ pub(super) fn trace_samples(
                 }
                 let first = *out.offsets.last().unwrap_or(&0) as usize;
                 let mut bb = Rect::EMPTY;
+                let mut reach = Vec2::splat(POINT_CELL);
                 for (p, h) in out.points[first..].iter().zip(&out.cells[first..]) {
                     bb = bb.union(&Rect::around(*p, h.abs()));
+                    reach = reach.max(h.abs());
                 }
                 out.bbox.push(bb);
+                out.reach.push(reach);
+                let points = &out.points[first..];
+                // At most `super::MAX_JOINT_SAMPLES` per pixel (checked before the trace).
+                let mut by_v: Vec<u16> = (0..points.len() as u16).collect();
+                by_v.sort_by(|&a, &b| points[a as usize].y.total_cmp(&points[b as usize].y));
+                out.by_v.extend(by_v);
                 out.offsets.push(out.points.len() as u32);
             }
             // From the water pixels' samples alone: the bound is about the lobes' kernels.
