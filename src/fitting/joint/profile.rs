@@ -23,6 +23,11 @@ const PROFILE_CHUNK: usize = 2048;
 /// distribution function is read from ([`control_variate::normal_cdf`]).
 const CUBIC_WINDOW: f64 = 0.05;
 
+/// The most ramps a pixel may have on the grid for its sums to be taken as polynomials over
+/// the runs between them ([`PieceSums`]): each run costs about as much as a few grid points,
+/// and the ramps are sorted first; a pixel with more is summed point by point.
+const PIECE_RAMPS: usize = 8;
+
 /// The mass of Gaussian `g` inside the rectangle as the edge moves over `window`, as a
 /// cubic in the window's x ([`Window::cubic`]): its share across the edge is `across`, along
 /// it the mass between the edge and the opposite edge `opp` (above the edge for a lower
@@ -198,7 +203,8 @@ impl Problem {
             }
             let (rest, rest_dev) = self.others(st, k, i);
             let res = [0, 1, 2].map(|ch| self.obs[i][ch] as f64 - rest[ch]);
-            if let (false, Some(window)) = (self.clipped[i], window) {
+            let few_ramps = ramps.ramp_count() <= PIECE_RAMPS;
+            if let (false, true, Some(window)) = (self.clipped[i], few_ramps, window) {
                 // The control variate's part as a cubic in the window's x, when it is one.
                 let gauss = if gauss_varies {
                     narrow_gauss(&window, &g, g_across, g_mean, g_sd, opp, min_edge)

@@ -133,6 +133,9 @@ pub(super) struct EdgeRamps {
     /// Per ramp: the grid point it is recorded at, its slope and its slope times its kink
     /// (absolute and signed).
     kinks: Vec<(usize, [f64; 2], [f64; 2])>,
+    /// [`Self::values`]' bins: per grid point, the slopes and slopes times kinks of the ramps
+    /// recorded there.
+    slope: Vec<[[f64; 2]; 2]>,
 }
 
 impl EdgeRamps {
@@ -146,6 +149,7 @@ impl EdgeRamps {
             constant: [0.0; 2],
             kinked: false,
             kinks: Vec::new(),
+            slope: Vec::new(),
         }
     }
 
@@ -203,16 +207,34 @@ impl EdgeRamps {
         }
     }
 
-    /// The coefficient's sum of weights (absolute, signed) at every grid point.
+    /// How many ramps start on the grid: [`Self::for_each_piece`] sorts them, so it is for
+    /// a few; [`Self::values`] takes any number at the same cost.
+    pub(super) fn ramp_count(&self) -> usize {
+        self.kinks.len()
+    }
+
+    /// The coefficient's sum of weights (absolute, signed) at every grid point: the ramps
+    /// binned by grid point, then prefix sums.
     pub(super) fn values(&mut self, abs: &mut [f32], signed: &mut [f32]) {
-        let (lo, step) = (self.lo, self.step);
-        self.for_each_piece(|j0, j1, intercept, slope| {
-            for j in j0..j1 {
-                let t = lo + j as f64 * step;
-                abs[j] = (intercept[0] + t * slope[0]) as f32;
-                signed[j] = (intercept[1] + t * slope[1]) as f32;
+        self.slope.clear();
+        self.slope.resize(self.grid, [[0.0; 2]; 2]);
+        for &(j, slope, slope_kink) in &self.kinks {
+            let bin = &mut self.slope[j];
+            for c in 0..2 {
+                bin[0][c] += slope[c];
+                bin[1][c] += slope_kink[c];
             }
-        });
+        }
+        let (mut s, mut sk) = ([0f64; 2], [0f64; 2]);
+        for (j, (a, b)) in abs.iter_mut().zip(signed.iter_mut()).enumerate() {
+            for c in 0..2 {
+                s[c] += self.slope[j][0][c];
+                sk[c] += self.slope[j][1][c];
+            }
+            let t = self.lo + j as f64 * self.step;
+            *a = (self.constant[0] + t * s[0] - sk[0]) as f32;
+            *b = (self.constant[1] + t * s[1] - sk[1]) as f32;
+        }
     }
 
     /// Adds a sample's kernel of half-width h at x along the edge's axis ([`kernel_coverage`];
