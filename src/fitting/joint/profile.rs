@@ -160,12 +160,14 @@ impl Problem {
                 same_everywhere(st.coef[k][i] as f64, st.dev[k][i] as f64, &mut flat);
                 continue;
             }
+            // The Gaussian's mass inside the rectangle as it is now.
+            let g_now = g.mass_inside(&rect);
             ramps.clear(grid);
             let mut any = false;
             if !samples_reach && !self.clipped[i] {
                 // Only the Gaussian moves: the samples' part is what it is now.
                 let inv = self.inv_samples as f64;
-                let sampled = st.coef[k][i] as f64 - g.mass_inside(&rect) as f64;
+                let sampled = st.coef[k][i] as f64 - g_now as f64;
                 let dev = st.dev[k][i] as f64 / inv;
                 ramps.constant(sampled / inv, dev);
                 any = true;
@@ -179,7 +181,7 @@ impl Problem {
                 let near = plane.near(i, along_u, lo.min(cur), hi.max(cur));
                 let (near_now, near_now_signed) = plane.sums_inside(near.clone(), &rect);
                 let inv = self.inv_samples as f64;
-                let far = (st.coef[k][i] as f64 - g.mass_inside(&rect) as f64) / inv - near_now;
+                let far = (st.coef[k][i] as f64 - g_now as f64) / inv - near_now;
                 let far_signed = st.dev[k][i] as f64 / inv - near_now_signed;
                 if far != 0.0 || far_signed != 0.0 {
                     ramps.constant(far, far_signed);
@@ -190,14 +192,14 @@ impl Problem {
                 }
             }
             if !any && !gauss_varies && !self.clipped[i] {
-                same_everywhere(g.mass_inside(&rect) as f64, 0.0, &mut flat);
+                same_everywhere(g_now as f64, 0.0, &mut flat);
                 continue;
             }
             if !ramps.kinked && !self.clipped[i] && !gauss_varies {
                 // Every kernel it has lies wholly on one side of the window.
                 let [c, d] = ramps.constant;
                 let inv = self.inv_samples as f64;
-                let c = c * inv + g.mass_inside(&rect) as f64;
+                let c = c * inv + g_now as f64;
                 same_everywhere(c, d * inv, &mut flat);
                 continue;
             }
@@ -209,7 +211,7 @@ impl Problem {
                 let gauss = if gauss_varies {
                     narrow_gauss(&window, &g, g_across, g_mean, g_sd, opp, min_edge)
                 } else {
-                    Some([g.mass_inside(&rect) as f64, 0.0, 0.0, 0.0])
+                    Some([g_now as f64, 0.0, 0.0, 0.0])
                 };
                 if let Some(gauss) = gauss {
                     let inv = self.inv_samples as f64;
@@ -243,7 +245,7 @@ impl Problem {
                     *c += scale * inside.max(0.0) as f32;
                 }
             } else if !g.is_none() {
-                let a = g.mass_inside(&rect) / self.inv_samples;
+                let a = g_now / self.inv_samples;
                 for c in cvals.iter_mut() {
                     *c += a;
                 }
