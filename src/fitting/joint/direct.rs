@@ -167,9 +167,10 @@ fn probe(
 }
 
 /// A stored sample before it is sorted by plane: the plane's index, where it lands, its
-/// kernel's half-widths (negative: a plain box), its weight and its half (+1 or -1; 0 for a
-/// direct sample).
-pub(super) type Hit = (u16, Vec2, Vec2, f32, f32);
+/// kernel's half-widths (negative: a plain box), its weight, its half (+1 or -1; 0 for a
+/// direct sample) and, once the pixel's samples are in store order, an entry of its plane's
+/// order in v (`samples::in_store_order`; 0 until then).
+pub(super) type Hit = (u16, Vec2, Vec2, f32, f32, u16);
 
 /// Camera rays per direct pixel: one through the centre of each of its `CAMERA_STRATA^2`
 /// strata, as a water pixel's camera rays are stratified.
@@ -212,7 +213,7 @@ pub(super) fn direct_hits(
             let q = plane.coords(origin + dir * hit.t);
             let cell = stratum_cell(scene, plane, fx, fy, inv_c, width, height);
             if r.overlaps(&Rect::around(q, cell)) {
-                hits.push((k as u16, q, -cell, weight, 0.0));
+                hits.push((k as u16, q, -cell, weight, 0.0, 0));
             }
         }
     }

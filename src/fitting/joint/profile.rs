@@ -179,7 +179,8 @@ impl Problem {
                 // tenth of the samples are near).
                 let cur = rect.edge(side);
                 let near = plane.near(i, along_u, lo.min(cur), hi.max(cur));
-                let (near_now, near_now_signed) = plane.sums_inside(near.clone(), &rect);
+                let (touched, (near_now, near_now_signed)) =
+                    plane.add_to_ramps(near, &frame, Some(cur), &mut ramps);
                 let inv = self.inv_samples as f64;
                 let far = (st.coef[k][i] as f64 - g_now as f64) / inv - near_now;
                 let far_signed = st.dev[k][i] as f64 / inv - near_now_signed;
@@ -187,9 +188,7 @@ impl Problem {
                     ramps.constant(far, far_signed);
                     any = true;
                 }
-                if plane.add_to_ramps(near, &frame, &mut ramps) {
-                    any = true;
-                }
+                any |= touched;
             }
             if !any && !gauss_varies && !self.clipped[i] {
                 same_everywhere(g_now as f64, 0.0, &mut flat);

@@ -58,7 +58,12 @@ impl PlaneSamples {
         dev: &mut [f32],
     ) {
         ramps.clear(coef.len());
-        self.add_to_ramps(Near::Run(self.range(i)), &EdgeFrame::new(rect, side), ramps);
+        self.add_to_ramps(
+            Near::Run(self.range(i)),
+            &EdgeFrame::new(rect, side),
+            None,
+            ramps,
+        );
         ramps.values(coef, dev);
         let g = &self.gauss[i];
         for (j, (c, d)) in coef.iter_mut().zip(dev.iter_mut()).enumerate() {
@@ -74,14 +79,26 @@ impl PlaneSamples {
 
     /// Adds the samples `ids` to `ramps` as functions of the edge `frame` describes (each
     /// sample's kernel, its share across the edge's axis inside the rectangle counted);
-    /// returns whether any counts anywhere on the ramps' grid.
+    /// returns whether any counts anywhere on the ramps' grid and, with the edge at `now`,
+    /// their sums of weight inside the rectangle (plain and signed by half, as
+    /// [`Self::sums_inside`] gives them; zero without `now`), from the same pass.
     pub(super) fn add_to_ramps(
         &self,
         ids: Near<'_>,
         frame: &EdgeFrame,
+        now: Option<f32>,
         ramps: &mut EdgeRamps,
-    ) -> bool {
+    ) -> (bool, (f64, f64)) {
         let mut any = false;
+        let (mut sum, mut signed) = (0f64, 0f64);
+        // The rectangle's extent along the edge's axis with the edge at `now`.
+        let along = now.map(|t| {
+            if frame.min_edge {
+                (t, frame.opposite)
+            } else {
+                (frame.opposite, t)
+            }
+        });
         for q in ids {
             let (p, h, w, half) = (
                 self.points[q],
@@ -105,9 +122,17 @@ impl PlaneSamples {
                     weight,
                     weight * half as f64,
                 );
+                if let Some((a, b)) = along {
+                    let f = kernel_coverage(x, hx, a, b) * across;
+                    if f != 0.0 {
+                        let w = (w * f) as f64;
+                        sum += w;
+                        signed += w * half as f64;
+                    }
+                }
             }
         }
-        any
+        (any, (sum, signed))
     }
 }
 

@@ -187,9 +187,11 @@ pub(super) fn trace_samples(
             let mut rng = Rng::new(seed, stream);
             let (x, y) = (pixel % width, pixel / width);
             if index >= first_direct {
-                let mut hits = direct_hits(scene, planes, roi, x, y, width, height, direct_weight);
-                hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
-                return (hits, vec![LobeGaussian::NONE; planes.len()]);
+                let hits = direct_hits(scene, planes, roi, x, y, width, height, direct_weight);
+                return (
+                    in_store_order(hits, planes.len()),
+                    vec![LobeGaussian::NONE; planes.len()],
+                );
             }
             let mut hits = Vec::new();
             let mut missed_water = 0u32;
@@ -310,7 +312,7 @@ pub(super) fn trace_samples(
                             }
                         };
                         if weight != 0.0 {
-                            hits.push((k as u16, q, cell, weight, half_sign));
+                            hits.push((k as u16, q, cell, weight, half_sign, 0));
                         }
                     }
                 }
@@ -322,13 +324,7 @@ pub(super) fn trace_samples(
             for g in gauss.iter_mut() {
                 g.mass *= drew;
             }
-            // Stored in order of u (see `PlaneSamples::near`); stable, so that the order is
-            // the same on every run.
-            hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
-            // Every pixel's hits stay alive until all are stored: without the slack a
-            // growing vector keeps (up to as much again), the joint fit peaks lower.
-            hits.shrink_to_fit();
-            (hits, gauss)
+            (in_store_order(hits, planes.len()), gauss)
         })
         .collect();
     // Each plane's samples, counted first so that its vectors are allocated once, at their
@@ -360,12 +356,13 @@ pub(super) fn trace_samples(
             out.offsets.push(0);
             for (hits, gauss) in &per_pixel {
                 out.gauss.push(gauss[k]);
-                for &(kk, p, cell, w, half) in hits {
+                for &(kk, p, cell, w, half, v_order) in hits {
                     if kk as usize == k {
                         out.points.push(p);
                         out.cells.push(cell);
                         out.weights.push(w);
                         out.halves.push(half);
+                        out.by_v.push(v_order);
                     }
                 }
                 let first = *out.offsets.last().unwrap_or(&0) as usize;
@@ -377,11 +374,6 @@ pub(super) fn trace_samples(
                 }
                 out.bbox.push(bb);
                 out.reach.push(reach);
-                let points = &out.points[first..];
-                // At most `super::MAX_JOINT_SAMPLES` per pixel (checked before the trace).
-                let mut by_v: Vec<u16> = (0..points.len() as u16).collect();
-                by_v.sort_by(|&a, &b| points[a as usize].y.total_cmp(&points[b as usize].y));
-                out.by_v.extend(by_v);
                 out.offsets.push(out.points.len() as u32);
             }
             // From the water pixels' samples alone: the bound is about the lobes' kernels.
@@ -391,6 +383,35 @@ pub(super) fn trace_samples(
         })
         .collect();
     (stored, per_pixel_samples)
+}
+
+/// One pixel's samples as the planes store them: in order of u (see [`PlaneSamples::near`];
+/// a stable sort, so that the order is the same on every run), each carrying, as its last
+/// field, the entry of its plane's order in v ([`PlaneSamples::by_v`]) at its place among
+/// that plane's samples. Sorted here, in the parallel trace, rather than while the planes
+/// are gathered.
+fn in_store_order(mut hits: Vec<Hit>, planes: usize) -> Vec<Hit> {
+    hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
+    // Every pixel's hits stay alive until all are stored: without the slack a growing vector
+    // keeps (up to as much again), the joint fit peaks lower.
+    hits.shrink_to_fit();
+    let mut mine = Vec::new();
+    for k in 0..planes {
+        mine.clear();
+        mine.extend((0..hits.len()).filter(|&q| hits[q].0 as usize == k));
+        // At most `super::MAX_JOINT_SAMPLES` per pixel (checked before the trace).
+        let mut order: Vec<u16> = (0..mine.len() as u16).collect();
+        order.sort_by(|&a, &b| {
+            hits[mine[a as usize]]
+                .1
+                .y
+                .total_cmp(&hits[mine[b as usize]].1.y)
+        });
+        for (&q, v) in mine.iter().zip(order) {
+            hits[q].5 = v;
+        }
+    }
+    hits
 }
 
 /// Fisher-Yates shuffle from the pixel's own stream.

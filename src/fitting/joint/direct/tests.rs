@@ -59,7 +59,7 @@ fn coefficient(scene: &Scene, plane: &LightPlane, rect: &Rect, x: u32, y: u32) -
     );
     let c: f32 = hits
         .iter()
-        .map(|&(k, q, h, w, half)| {
+        .map(|&(k, q, h, w, half, _)| {
             assert_eq!((k, half), (0, 0.0));
             w * kernel_coverage(q.x, h.x, rect.u_min, rect.u_max)
                 * kernel_coverage(q.y, h.y, rect.v_min, rect.v_max)
