@@ -12,21 +12,37 @@ use super::samples::PlaneSamples;
 use crate::fitting::rect::Rect;
 
 impl PlaneSamples {
-    /// The samples `ids`' sums of weight (plain and signed by half) inside `rect`, not yet
-    /// divided by the sample count: their part of [`Self::coefficient`].
-    pub(super) fn sums_inside(&self, ids: Near<'_>, rect: &Rect) -> (f64, f64) {
-        let (mut sum, mut signed) = (0f64, 0f64);
+    /// The samples `ids`' sums of weight (plain and signed by half) inside `from` and inside
+    /// `to`, not yet divided by the sample count (their part of [`Self::coefficient`] for
+    /// each): two rectangles that differ only along u (`along_u`) or only along v, in one
+    /// pass, each sample's share across that axis being the same in both.
+    fn sums_inside_both(
+        &self,
+        ids: Near<'_>,
+        along_u: bool,
+        from: &Rect,
+        to: &Rect,
+    ) -> [(f64, f64); 2] {
+        let mut sums = [(0f64, 0f64); 2];
         for q in ids {
             let (p, h) = (self.points[q], self.cells[q]);
-            let f = kernel_coverage(p.x, h.x, rect.u_min, rect.u_max)
-                * kernel_coverage(p.y, h.y, rect.v_min, rect.v_max);
-            if f != 0.0 {
-                let w = (self.weights[q] * f) as f64;
-                sum += w;
-                signed += w * self.halves[q] as f64;
+            // Each product in the order `coefficient` takes it (u, then v).
+            let f = if along_u {
+                let v = kernel_coverage(p.y, h.y, from.v_min, from.v_max);
+                [from, to].map(|r| kernel_coverage(p.x, h.x, r.u_min, r.u_max) * v)
+            } else {
+                let u = kernel_coverage(p.x, h.x, from.u_min, from.u_max);
+                [from, to].map(|r| u * kernel_coverage(p.y, h.y, r.v_min, r.v_max))
+            };
+            for (f, (sum, signed)) in f.into_iter().zip(sums.iter_mut()) {
+                if f != 0.0 {
+                    let w = (self.weights[q] * f) as f64;
+                    *sum += w;
+                    *signed += w * self.halves[q] as f64;
+                }
             }
         }
-        (sum, signed)
+        sums
     }
 
     /// The samples of pixel i whose kernels may reach the band `[lo, hi]` of u (`along_u`)
@@ -75,8 +91,7 @@ impl PlaneSamples {
             return (c1 as f64 - c0 as f64, d1 as f64 - d0 as f64);
         };
         let near = self.near(i, along_u, a.min(b), a.max(b));
-        let (s0, d0) = self.sums_inside(near.clone(), from);
-        let (s1, d1) = self.sums_inside(near, to);
+        let [(s0, d0), (s1, d1)] = self.sums_inside_both(near, along_u, from, to);
         let g = &self.gauss[i];
         let inv = inv_samples as f64;
         (

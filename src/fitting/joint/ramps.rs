@@ -80,8 +80,9 @@ impl PlaneSamples {
     /// Adds the samples `ids` to `ramps` as functions of the edge `frame` describes (each
     /// sample's kernel, its share across the edge's axis inside the rectangle counted);
     /// returns whether any counts anywhere on the ramps' grid and, with the edge at `now`,
-    /// their sums of weight inside the rectangle (plain and signed by half, as
-    /// [`Self::sums_inside`] gives them; zero without `now`), from the same pass.
+    /// their sums of weight inside the rectangle (plain and signed by half, not yet divided
+    /// by the sample count: their part of [`Self::coefficient`]; zero without `now`), from
+    /// the same pass.
     pub(super) fn add_to_ramps(
         &self,
         ids: Near<'_>,
