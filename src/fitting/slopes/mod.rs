@@ -13,6 +13,10 @@
 //! with `S` the joint fit's noise-debiased residual sum of squares, by the same
 //! one-dimensional search over the logarithm, one axis at a time: along, then across, then
 //! along again when across moved (the two interact through the rectangle's corners only).
+//! Each pass after the first searches from the lowest fit made so far, both axes (the
+//! estimate of the axis it left lies within the search's tolerance of that fit), so the
+//! middle of its first three points is a fit already made: two fits fewer of the eleven a
+//! full search took on Table 1's photo over a flat quad, the estimates within 0.3 %.
 //! Every fit starts from the same lights (the paper fit at the starting variances), reads the
 //! same pixels (those the broadest lobe of the search can see: four times the starting
 //! variances) with the same random numbers, so the costs are comparable.
@@ -176,6 +180,12 @@ pub fn estimate_slopes(
     // Each axis's last pass: (ln variance, the lights fitted there).
     let mut passes: [Vec<(f64, Vec<FittedLight>)>; 2] = [Vec::new(), Vec::new()];
     let mut variance = start_variance;
+    // Every fit made so far, by its variances, and the one of lowest cost: each pass after
+    // the first searches from there (its axis's estimate lies within the tolerance of it),
+    // so the middle of its first three points is a fit already made, read again rather than
+    // made again.
+    let mut made: Vec<([f32; 2], Point, Vec<FittedLight>)> = Vec::new();
+    let mut anchor = start_variance;
     let mut sigma_ln = [None, None];
     let t = Instant::now();
     let eval = |v: [f32; 2],
@@ -226,13 +236,22 @@ pub fn estimate_slopes(
         pass_points.clear();
         let found = search(
             options,
-            (variance[axis] as f64).ln(),
+            (anchor[axis] as f64).ln(),
             (lo_ln, hi_ln),
             (name, show),
             |x| {
-                let mut v = variance;
+                let mut v = anchor;
                 v[axis] = x.exp() as f32;
-                let (p, lights) = eval(v, &mut evaluations)?;
+                // The same variances to rounding (the logarithm and back).
+                let same = |m: &[f32; 2]| (0..2).all(|a| (m[a] / v[a] - 1.0).abs() < 1e-6);
+                let (p, lights) = match made.iter().find(|m| same(&m.0)) {
+                    Some((_, p, lights)) => (*p, lights.clone()),
+                    None => {
+                        let (p, lights) = eval(v, &mut evaluations)?;
+                        made.push((v, p, lights.clone()));
+                        (p, lights)
+                    }
+                };
                 if p.s.is_finite() {
                     pass_points.push((x, lights));
                 }
@@ -240,6 +259,13 @@ pub fn estimate_slopes(
             },
         )?;
         variance[axis] = found.x.exp() as f32;
+        if let Some(best) = made
+            .iter()
+            .filter(|m| m.1.s.is_finite())
+            .min_by(|a, b| a.1.s.total_cmp(&b.1.s))
+        {
+            anchor = best.0;
+        }
         sigma_ln[axis] = found.sigma_ln.map(|s| s as f32);
         match found.stop {
             Stop::Converged => {}
