@@ -176,24 +176,21 @@ pub fn estimate_slopes(
         progress: final_fit.progress,
         ..JointOptions::new(model, paper.seed)
     };
-    let mut evaluations: Vec<([f32; 2], f64)> = Vec::new();
     // Each axis's last pass: (ln variance, the lights fitted there).
     let mut passes: [Vec<(f64, Vec<FittedLight>)>; 2] = [Vec::new(), Vec::new()];
     let mut variance = start_variance;
-    // Every fit made so far, by its variances, and the one of lowest cost: each pass after
-    // the first searches from there (its axis's estimate lies within the tolerance of it),
-    // so the middle of its first three points is a fit already made, read again rather than
-    // made again.
+    // Every fit made so far, in order, by its variances (the evaluations reported), and the
+    // one of lowest cost: each pass after the first searches from there (its axis's estimate
+    // lies within the tolerance of it), so the middle of its first three points is a fit
+    // already made, read again rather than made again.
     let mut made: Vec<([f32; 2], Point, Vec<FittedLight>)> = Vec::new();
     let mut anchor = start_variance;
     let mut sigma_ln = [None, None];
     let t = Instant::now();
-    let eval = |v: [f32; 2],
-                evaluations: &mut Vec<([f32; 2], f64)>|
-     -> Result<(Point, Vec<FittedLight>)> {
+    // The `number`-th fit, at variances `v`.
+    let eval = |v: [f32; 2], number: usize| -> Result<(Point, Vec<FittedLight>)> {
         final_fit.progress.stage(&format!(
-            "slope search: joint fit {} at variances {:.2e} along, {:.2e} across",
-            evaluations.len() + 1,
+            "slope search: joint fit {number} at variances {:.2e} along, {:.2e} across",
             v[0],
             v[1]
         ));
@@ -211,7 +208,6 @@ pub fn estimate_slopes(
         } else {
             f64::INFINITY
         };
-        evaluations.push((v, s));
         Ok((
             Point {
                 x: 0.0,
@@ -247,7 +243,7 @@ pub fn estimate_slopes(
                 let (p, lights) = match made.iter().find(|m| same(&m.0)) {
                     Some((_, p, lights)) => (*p, lights.clone()),
                     None => {
-                        let (p, lights) = eval(v, &mut evaluations)?;
+                        let (p, lights) = eval(v, made.len() + 1)?;
                         made.push((v, p, lights.clone()));
                         (p, lights)
                     }
@@ -279,6 +275,7 @@ pub fn estimate_slopes(
             )),
         }
     }
+    let evaluations: Vec<([f32; 2], f64)> = made.iter().map(|m| (m.0, m.1.s)).collect();
     timings.push((
         format!("slope search ({} evaluations)", evaluations.len()),
         t.elapsed().as_secs_f64(),
