@@ -191,8 +191,7 @@ pub fn estimate_slopes(
     let eval = |v: [f32; 2], number: usize| -> Result<(Point, Vec<FittedLight>)> {
         final_fit.progress.stage(&format!(
             "slope search: joint fit {number} at variances {:.2e} along, {:.2e} across",
-            v[0],
-            v[1]
+            v[0], v[1]
         ));
         let fit = fit_joint_with(
             &water_with_total(surface, v),
