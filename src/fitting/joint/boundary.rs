@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::problem::{Problem, State};
 use super::ramps::EdgeRamps;
+use super::samples::PlaneSamples;
 use crate::fitting::rect::Rect;
 use crate::fitting::EdgeSide;
 
@@ -147,102 +148,85 @@ fn boundary_minima(
             )
         })
         .unzip();
-    // Per (outer offset, inner position) of one light: its coefficients and half-differences
-    // on the used pixels, its terms of the normal equations, and its raw diagonal (0 where
-    // the rectangle would be too small).
-    struct Column {
-        coef: Vec<f32>,
-        dev: Vec<f32>,
-        rhs: [f64; 3],
-        diag: f64,
-        raw: f64,
-    }
-    let empty = || Column {
-        coef: Vec::new(),
-        dev: Vec::new(),
-        rhs: [0.0; 3],
-        diag: 0.0,
-        raw: 0.0,
-    };
-    // Per outer offset, one pass over each pixel's samples gives its coefficient at every
-    // inner position (edge ramps); then the columns' sums.
-    let columns = |set: usize, r: Rect, outer: EdgeSide, inner: EdgeSide, base: f32| {
-        let samples = &problem.planes[set];
-        let mut out = Vec::with_capacity(OUTER_GRID * grid);
-        for o in 0..OUTER_GRID {
-            let r_o = r.with_edge(outer, r.edge(outer) + offset(o));
-            let rows: Vec<(Vec<f32>, Vec<f32>)> = used
-                .par_iter()
-                .map_init(
-                    || EdgeRamps::new(base, step, grid),
-                    |ramps, &i| {
-                        let (mut c, mut d) = (vec![0f32; grid], vec![0f32; grid]);
-                        samples.edge_coefficients(
-                            i,
-                            &r_o,
-                            inner,
-                            base,
-                            step,
-                            problem.inv_samples,
-                            ramps,
-                            &mut c,
-                            &mut d,
-                        );
-                        (c, d)
-                    },
-                )
-                .collect();
-            for j in 0..grid {
-                let t = base + j as f32 * step;
-                let rect = r_o.with_edge(inner, t);
-                let size = if vertical {
-                    rect.v_max - rect.v_min
-                } else {
-                    rect.u_max - rect.u_min
-                };
-                if !(lo..=hi).contains(&t) || size < min_size(set) {
-                    out.push(empty());
-                    continue;
-                }
-                let coef: Vec<f32> = rows.iter().map(|row| row.0[j]).collect();
-                let dev: Vec<f32> = rows.iter().map(|row| row.1[j]).collect();
-                let mut rhs = [0f64; 3];
-                let (mut diag, mut raw) = (0f64, 0f64);
-                for (u, (&c, &d)) in coef.iter().zip(&dev).enumerate() {
-                    let (c, d) = (c as f64, d as f64);
+    let outer_base = |r: Rect, side: EdgeSide| r.edge(side) + offset(0);
+    let parts_a = LightParts::new(
+        &problem.planes[set_a],
+        problem.inv_samples,
+        &used,
+        ra,
+        [inner[0], outer[0]],
+        (base_a, step, grid),
+        (outer_base(ra, outer[0]), outer_step * span),
+    );
+    let parts_b = LightParts::new(
+        &problem.planes[set_b],
+        problem.inv_samples,
+        &used,
+        rb,
+        [inner[1], outer[1]],
+        (base_b, step, grid),
+        (outer_base(rb, outer[1]), outer_step * span),
+    );
+    // Per (outer offset, inner position) of one light: its terms of the normal equations
+    // and its raw diagonal; None where the rectangle would be too small.
+    let summaries =
+        |parts: &LightParts, set: usize, r: Rect, at: &dyn Fn(usize) -> f32, outer_side| {
+            let own = parts.cross(parts);
+            let rhs = |c: &[f32], d: &[f32]| {
+                let mut g = [0f64; 3];
+                for (u, (&c, &d)) in c.iter().zip(d).enumerate() {
                     for ch in 0..3 {
-                        rhs[ch] += target[u][ch] * c + rest_dev[u][ch] * d;
+                        g[ch] += target[u][ch] * c as f64 + rest_dev[u][ch] * d as f64;
                     }
-                    diag += c * c - d * d;
-                    raw += c * c;
                 }
-                out.push(Column {
-                    coef,
-                    dev,
-                    rhs,
-                    diag: diag.max(0.5 * raw),
-                    raw,
-                });
+                g
+            };
+            let rhs_inner: Vec<[f64; 3]> = (0..grid)
+                .into_par_iter()
+                .map(|j| rhs(&parts.inner[j].0, &parts.inner[j].1))
+                .collect();
+            let rhs_outer: Vec<[f64; 3]> = (0..OUTER_GRID)
+                .into_par_iter()
+                .map(|o| rhs(&parts.outer[o].0, &parts.outer[o].1))
+                .collect();
+            let mut out = Vec::with_capacity(OUTER_GRID * grid);
+            for (o, g_outer) in rhs_outer.iter().enumerate() {
+                let x_o = r.edge(outer_side) + offset(o);
+                for (j, g_inner) in rhs_inner.iter().enumerate() {
+                    let t = at(j);
+                    let size = if outer_side.is_min() {
+                        t - x_o
+                    } else {
+                        x_o - t
+                    };
+                    if !(lo..=hi).contains(&t) || size < min_size(set) {
+                        out.push(None);
+                        continue;
+                    }
+                    let [plain, signed] = own.pair(j, o, j, o);
+                    out.push(Some(Column {
+                        rhs: [0, 1, 2].map(|ch| g_inner[ch] + g_outer[ch]),
+                        diag: (plain - signed).max(0.5 * plain),
+                        raw: plain,
+                    }));
+                }
             }
-        }
-        out
-    };
-    let col_a = columns(set_a, ra, outer[0], inner[0], base_a);
-    let col_b = columns(set_b, rb, outer[1], inner[1], base_b);
+            out
+        };
+    let col_a = summaries(&parts_a, set_a, ra, &at_a, outer[0]);
+    let col_b = summaries(&parts_b, set_b, rb, &at_b, outer[1]);
+    let cross_ab = parts_a.cross(&parts_b);
     // The cost, less its constant part, with both radiances at their nonnegative optimum:
     // per channel min over L >= 0 of L^T A L - 2 L . g.
-    let pair_cost = |xa: usize, xb: usize| -> f64 {
-        let (ca, cb) = (&col_a[xa], &col_b[xb]);
+    let pair_cost = |(oa, ja): (usize, usize), (ob, jb): (usize, usize)| -> f64 {
+        let (Some(ca), Some(cb)) = (&col_a[oa * grid + ja], &col_b[ob * grid + jb]) else {
+            return f64::INFINITY;
+        };
         if ca.raw == 0.0 || cb.raw == 0.0 {
             return f64::INFINITY;
         }
-        let cross: f64 = ca
-            .coef
-            .iter()
-            .zip(&cb.coef)
-            .zip(ca.dev.iter().zip(&cb.dev))
-            .map(|((&x, &y), (&dx, &dy))| x as f64 * y as f64 - dx as f64 * dy as f64)
-            .sum();
+        let [plain, signed] = cross_ab.pair(ja, oa, jb, ob);
+        let cross = plain - signed;
         let (aa, bb) = (ca.diag, cb.diag);
         (0..3)
             .map(|ch| {
@@ -279,7 +263,7 @@ fn boundary_minima(
         .collect();
     let costs: Vec<f64> = points
         .par_iter()
-        .map(|p| pair_cost(p[0] * grid + p[1], p[3] * grid + p[2]))
+        .map(|p| pair_cost((p[0], p[1]), (p[3], p[2])))
         .collect();
     let index: std::collections::HashMap<Point, f64> =
         points.iter().copied().zip(costs.iter().copied()).collect();
@@ -312,6 +296,152 @@ fn boundary_minima(
         .collect()
 }
 
+/// One column's terms of the boundary search's normal equations: `g = sum (target c +
+/// rest_dev d)` per channel, its diagonal (noise-debiased, floored at half the raw one) and
+/// its raw diagonal `sum c^2`.
+struct Column {
+    rhs: [f64; 3],
+    diag: f64,
+    raw: f64,
+}
+
+/// An edge beyond every sample, as the far side of a rectangle whose near side alone moves.
+const FAR: f32 = 1.0e6;
+
+/// One light's coefficients and half-differences on the used pixels with its inner edge at
+/// every grid point `j` and its outer edge at every offset `o`, in two parts: along the edges'
+/// axis every sample's kernel, and the control variate's Gaussian, put a mass `F(hi) - F(lo)`
+/// inside the rectangle (one cumulative function read at both edges), so
+/// `c(o, j) = inner[j] + outer[o]` with `inner[j]` the coefficient with the outer edge at its
+/// offset farthest from the inner one (every valid rectangle holds it) and
+/// `outer[o] = F(x_far) - F(x_o)` (with its sign for the side). Two passes over the samples
+/// give every combination, and the dot products the search needs split the same way
+/// ([`LightParts::cross`]).
+struct LightParts {
+    /// Per inner grid point: (coefficients, half-differences) over the used pixels.
+    inner: Vec<(Vec<f32>, Vec<f32>)>,
+    /// Per outer offset: the same, as the change from the farthest offset.
+    outer: Vec<(Vec<f32>, Vec<f32>)>,
+}
+
+/// The dot products `sum c c'` and `sum d d'` between two lights' parts (see
+/// [`LightParts::cross`]).
+struct Cross {
+    inner_inner: Vec<[f64; 2]>,
+    inner_outer: Vec<[f64; 2]>,
+    outer_inner: Vec<[f64; 2]>,
+    outer_outer: Vec<[f64; 2]>,
+    grid: usize,
+}
+
+impl Cross {
+    /// `[sum c c', sum d d']` between the first light at inner point `j` and outer offset `o`
+    /// and the second at `j2`, `o2`.
+    fn pair(&self, j: usize, o: usize, j2: usize, o2: usize) -> [f64; 2] {
+        let g = self.grid;
+        let terms = [
+            self.inner_inner[j * g + j2],
+            self.inner_outer[j * OUTER_GRID + o2],
+            self.outer_inner[o * g + j2],
+            self.outer_outer[o * OUTER_GRID + o2],
+        ];
+        [0, 1].map(|m| terms.iter().map(|t| t[m]).sum())
+    }
+}
+
+impl LightParts {
+    /// The parts of light `r` reading `samples` (each sample's weight times `inv`) on the
+    /// pixels `used`, whose `[inner, outer]` edges move: the inner one over `grid` points
+    /// `base + j step`, the outer one over [`OUTER_GRID`] offsets `outer_base + o outer_step`.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        samples: &PlaneSamples,
+        inv: f32,
+        used: &[usize],
+        r: Rect,
+        [inner, outer]: [EdgeSide; 2],
+        (base, step, grid): (f32, f32, usize),
+        (outer_base, outer_step): (f32, f32),
+    ) -> Self {
+        // The outer offset farthest from the inner edge: the lowest for a bottom or left edge.
+        let far = if outer.is_min() { 0 } else { OUTER_GRID - 1 };
+        let with_far_outer = r.with_edge(outer, outer_base + far as f32 * outer_step);
+        let with_far_inner = r.with_edge(inner, if inner.is_min() { -FAR } else { FAR });
+        type Row = (Vec<f32>, Vec<f32>, [f32; OUTER_GRID], [f32; OUTER_GRID]);
+        let rows: Vec<Row> = used
+            .par_iter()
+            .map_init(
+                || {
+                    (
+                        EdgeRamps::new(base, step, grid),
+                        EdgeRamps::new(outer_base, outer_step, OUTER_GRID),
+                    )
+                },
+                |(ramps, outer_ramps), &i| {
+                    let (mut c, mut d) = (vec![0f32; grid], vec![0f32; grid]);
+                    samples.edge_coefficients(
+                        i,
+                        &with_far_outer,
+                        inner,
+                        base,
+                        step,
+                        inv,
+                        ramps,
+                        &mut c,
+                        &mut d,
+                    );
+                    let (mut oc, mut od) = ([0f32; OUTER_GRID], [0f32; OUTER_GRID]);
+                    samples.edge_coefficients(
+                        i,
+                        &with_far_inner,
+                        outer,
+                        outer_base,
+                        outer_step,
+                        inv,
+                        outer_ramps,
+                        &mut oc,
+                        &mut od,
+                    );
+                    let (fc, fd) = (oc[far], od[far]);
+                    (c, d, oc.map(|x| x - fc), od.map(|x| x - fd))
+                },
+            )
+            .collect();
+        LightParts {
+            inner: (0..grid)
+                .map(|j| rows.iter().map(|r| (r.0[j], r.1[j])).unzip())
+                .collect(),
+            outer: (0..OUTER_GRID)
+                .map(|o| rows.iter().map(|r| (r.2[o], r.3[o])).unzip())
+                .collect(),
+        }
+    }
+
+    /// The dot products between every part of this light and every part of `other`.
+    fn cross(&self, other: &LightParts) -> Cross {
+        let dots = |xs: &[(Vec<f32>, Vec<f32>)], ys: &[(Vec<f32>, Vec<f32>)]| -> Vec<[f64; 2]> {
+            (0..xs.len() * ys.len())
+                .into_par_iter()
+                .map(|n| {
+                    let (x, y) = (&xs[n / ys.len()], &ys[n % ys.len()]);
+                    [dot(&x.0, &y.0), dot(&x.1, &y.1)]
+                })
+                .collect()
+        };
+        Cross {
+            inner_inner: dots(&self.inner, &other.inner),
+            inner_outer: dots(&self.inner, &other.outer),
+            outer_inner: dots(&self.outer, &other.inner),
+            outer_outer: dots(&self.outer, &other.outer),
+            grid: other.inner.len(),
+        }
+    }
+}
+
+fn dot(x: &[f32], y: &[f32]) -> f64 {
+    x.iter().zip(y).map(|(&a, &b)| a as f64 * b as f64).sum()
+}
+
 /// How many of the boundary search's lowest local minima are refined and descended from
 /// (the search's cost leaves out clipped pixels and holds the other edges, so its ranking
 /// is not final; on the stacked sample the lowest of them is often not the best basin).
@@ -321,3 +451,91 @@ const BOUNDARY_STARTS: usize = 3;
 /// kept and descended fully. 4 give the same fits as the full 14 on the stacked sample (8
 /// seeds), in half the time.
 pub(super) const CANDIDATE_SWEEPS: u32 = 4;
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixture::table3_light0;
+    use super::*;
+
+    /// The two parts add up to the coefficient and half-difference of every rectangle of the
+    /// search, and their dot products to those of the sums, for a light whose inner edge is
+    /// its top and one whose inner edge is its bottom.
+    #[test]
+    fn the_parts_add_up_to_every_rectangles_coefficients() {
+        let t = table3_light0();
+        let (planes, n) = t.trace(72, 1, 0, true);
+        let (samples, inv) = (&planes[0], 1.0 / n as f32);
+        let used: Vec<usize> = (0..t.pixels.len()).collect();
+        let r = t.light.rect();
+        let (grid, outer_step) = (9, 0.05 * r.height());
+        let step = 0.08 * r.height();
+        let mut parts = Vec::new();
+        for [inner, outer] in [
+            [EdgeSide::Top, EdgeSide::Bottom],
+            [EdgeSide::Bottom, EdgeSide::Top],
+        ] {
+            let base = r.edge(inner) - 0.3 * r.height();
+            let outer_base = r.edge(outer) - 2.0 * outer_step;
+            let p = LightParts::new(
+                samples,
+                inv,
+                &used,
+                r,
+                [inner, outer],
+                (base, step, grid),
+                (outer_base, outer_step),
+            );
+            let mut compared = 0;
+            for o in 0..OUTER_GRID {
+                for j in 0..grid {
+                    let rect = r
+                        .with_edge(outer, outer_base + o as f32 * outer_step)
+                        .with_edge(inner, base + j as f32 * step);
+                    if rect.v_max - rect.v_min <= 0.0 {
+                        continue;
+                    }
+                    for &i in &used {
+                        let (c, d) = samples.coefficient(i, &rect, inv);
+                        let (pc, pd) = (
+                            p.inner[j].0[i] + p.outer[o].0[i],
+                            p.inner[j].1[i] + p.outer[o].1[i],
+                        );
+                        let tolerance = 1e-6 + 1e-4 * c.abs().max(d.abs());
+                        assert!(
+                            (pc - c).abs() <= tolerance && (pd - d).abs() <= tolerance,
+                            "{inner:?} o {o} j {j} pixel {i}: ({pc}, {pd}) against ({c}, {d})"
+                        );
+                        compared += (c != 0.0) as usize;
+                    }
+                }
+            }
+            assert!(compared > 1000, "only {compared} nonzero coefficients");
+            parts.push(p);
+        }
+        let (a, b) = (&parts[0], &parts[1]);
+        let cross = a.cross(b);
+        for (j, o, j2, o2) in [(0, 0, 8, 4), (4, 2, 3, 1), (8, 4, 0, 0)] {
+            let sum = |p: &LightParts, j: usize, o: usize, m: usize| -> Vec<f64> {
+                let (inner, outer) = if m == 0 {
+                    (&p.inner[j].0, &p.outer[o].0)
+                } else {
+                    (&p.inner[j].1, &p.outer[o].1)
+                };
+                inner
+                    .iter()
+                    .zip(outer)
+                    .map(|(&x, &y)| x as f64 + y as f64)
+                    .collect()
+            };
+            let got = cross.pair(j, o, j2, o2);
+            for (m, got) in got.into_iter().enumerate() {
+                let (x, y) = (sum(a, j, o, m), sum(b, j2, o2, m));
+                let want: f64 = x.iter().zip(&y).map(|(p, q)| p * q).sum();
+                assert!(
+                    (got - want).abs() <= 1e-9 * want.abs().max(1e-12),
+                    "{m}: {got} against {want}"
+                );
+            }
+        }
+    }
+}
