@@ -148,25 +148,17 @@ fn boundary_minima(
             )
         })
         .unzip();
-    let outer_base = |r: Rect, side: EdgeSide| r.edge(side) + offset(0);
-    let parts_a = LightParts::new(
-        &problem.planes[set_a],
-        problem.inv_samples,
-        &used,
-        ra,
-        [inner[0], outer[0]],
-        (base_a, step, grid),
-        (outer_base(ra, outer[0]), outer_step * span),
-    );
-    let parts_b = LightParts::new(
-        &problem.planes[set_b],
-        problem.inv_samples,
-        &used,
-        rb,
-        [inner[1], outer[1]],
-        (base_b, step, grid),
-        (outer_base(rb, outer[1]), outer_step * span),
-    );
+    let [parts_a, parts_b] = [(set_a, ra, 0), (set_b, rb, 1)].map(|(set, r, m)| {
+        LightParts::new(
+            &problem.planes[set],
+            problem.inv_samples,
+            &used,
+            r,
+            [inner[m], outer[m]],
+            (if m == 0 { base_a } else { base_b }, step, grid),
+            (r.edge(outer[m]) + offset(0), outer_step * span),
+        )
+    });
     // Per (outer offset, inner position) of one light: its terms of the normal equations
     // and its raw diagonal; None where the rectangle would be too small.
     let summaries =
