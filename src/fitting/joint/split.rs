@@ -18,7 +18,8 @@ const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
 
 /// Tries to explain light k as two lights on its plane, side by side or one above the other
 /// (overlapping streaks merge into one region, method §5 and the paper's §5.3): each
-/// candidate starts from the rectangle cut in half and is fitted coarsely. Returns the
+/// candidate starts from the rectangle cut in half and is fitted coarsely, the other lights
+/// held. Returns the
 /// candidate with the lowest row-summed cost when it is below
 /// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, and the two edges that face each
 /// other (the first light's, then the second's, the new light last in the state). This only
@@ -56,8 +57,21 @@ pub(super) fn try_split(
         set_of.push(st.set_of[k]);
         pinned.push(st.pinned[k]);
         radiance.push(st.radiance[k]);
-        let mut trial = problem.state(set_of, pinned, rects, radiance);
+        // Only the two halves move: the other lights stay at the optimum of the descent
+        // before, so a trial sweeps over two lights rather than all of them (the descent
+        // after a split moves them all).
+        let held = (0..pinned.len())
+            .map(|j| {
+                if j == k || j == pinned.len() - 1 {
+                    pinned[j]
+                } else {
+                    [true; 4]
+                }
+            })
+            .collect();
+        let mut trial = problem.state(set_of, held, rects, radiance);
         problem.descend(&mut trial, extents, SPLIT_TRIAL_SWEEPS);
+        trial.pinned = pinned;
         let c = problem.row_cost(&trial);
         let both_lit = [k, trial.rects.len() - 1]
             .iter()
