@@ -20,6 +20,7 @@ use crate::progress::Reporter;
 use crate::random::Rng;
 use crate::scene_in::{AreaLight, Scene};
 use crate::settings::Setting;
+use crate::tracing::Hit;
 use crate::water_model::WaterModel;
 use crate::{Error, Result};
 
@@ -161,6 +162,10 @@ pub struct WaterPoint {
     pub clear: f32,
 }
 
+/// The least cosine to the water's face [`WaterPoint::tmin`] divides by: a flatter ray starts
+/// counting hits no farther than a thousand crest heights out.
+const MIN_CLEAR_COSINE: f32 = 1e-3;
+
 impl WaterPoint {
     /// The distance along a reflected ray in direction `wi` before which it ignores what it
     /// hits ([`clear`](Self::clear)): the ray is the one from `start`, only its occlusion
@@ -168,9 +173,25 @@ impl WaterPoint {
     #[inline]
     pub fn tmin(&self, wi: Vec3) -> f32 {
         if self.clear > 0.0 {
-            self.clear / wi.dot(self.face).max(1e-3)
+            self.clear / wi.dot(self.face).max(MIN_CLEAR_COSINE)
         } else {
             0.0
+        }
+    }
+
+    /// The first triangle a reflected ray in direction `wi` meets past [`tmin`](Self::tmin)
+    /// and before `tmax`. Past the crests (`clear` > 0) no water triangle lies ahead, so the
+    /// ray is traced against the others alone ([`Scene::closest_hit_above_water`]), unless it
+    /// is so grazing that `tmin` is capped below the crests' height.
+    #[inline]
+    pub fn reflected_hit(&self, scene: &Scene, wi: Vec3, tmax: f32) -> Option<Hit> {
+        let cos = wi.dot(self.face);
+        if self.clear > 0.0 && cos >= MIN_CLEAR_COSINE {
+            scene.closest_hit_above_water(self.start, wi, self.tmin(wi), tmax)
+        } else {
+            scene
+                .tracer
+                .closest_hit(self.start, wi, self.tmin(wi), tmax)
         }
     }
 

@@ -294,3 +294,62 @@ fn the_expected_image_holds_the_photos_flux_and_centroids() {
         under[0][0]
     );
 }
+
+/// The statistical model's reflected rays leave the mean plane and count hits only above the
+/// scene's highest crest, where no water triangle lies ahead: there the BVH over the other
+/// triangles (`Scene::closest_hit_above_water`) must give the hit the whole scene's gives,
+/// triangle and distance, for rays spread as a wave field's reflections are (the mirror
+/// direction tilted by slopes of up to 0.15 either way) from every part of the harbour photo.
+#[test]
+fn reflected_rays_above_the_crests_meet_what_the_whole_scene_shows_them() {
+    use glam::Vec3;
+    use streaklight::random::Rng;
+    use streaklight::water_model::{StatisticalSurface, WaterModel};
+
+    let scene = sample_scene("harbour-other-waves.gltf", None);
+    let (w, h) = (600, 600);
+    let water = StatisticalSurface {
+        surface: water_statistics(&scene, w, h).unwrap().surface,
+        waves: [3e-3, 2e-3],
+    };
+    assert!(water.surface.crest > 0.0, "{:?}", water.surface);
+    let mut rng = Rng::new(7, 0);
+    let (mut rays, mut walls, mut grazing) = (0, 0, 0);
+    for _ in 0..40_000 {
+        let (x, y) = (rng.next_f32() * w as f32, rng.next_f32() * h as f32);
+        let Some(p) = water.water_point(&scene, x, y, w, h) else {
+            continue;
+        };
+        let mirror = p.normal * (2.0 * p.normal.dot(p.wo)) - p.wo;
+        let tilt = Vec3::new(
+            rng.next_f32() - 0.5,
+            rng.next_f32() - 0.5,
+            rng.next_f32() - 0.5,
+        );
+        let wi = (mirror + 0.3 * tilt).normalize();
+        if wi.dot(p.face) <= 0.0 {
+            continue;
+        }
+        rays += 1;
+        let whole = scene
+            .tracer
+            .closest_hit(p.start, wi, p.tmin(wi), f32::INFINITY);
+        assert_eq!(
+            p.reflected_hit(&scene, wi, f32::INFINITY),
+            whole,
+            "{p:?} {wi}"
+        );
+        if let Some(hit) = whole {
+            assert!(!scene.is_water[hit.triangle as usize], "{p:?} {wi} {hit:?}");
+            walls += 1;
+        }
+        grazing += (wi.dot(p.face) < 0.05) as usize;
+    }
+    // Most rays reach the facades, and some leave the water within 3 degrees of it (where a
+    // ray walks farthest under the crests).
+    assert!(
+        rays > 10_000 && walls * 2 > rays,
+        "{rays} rays, {walls} on walls"
+    );
+    assert!(grazing > 100, "{grazing} grazing rays of {rays}");
+}

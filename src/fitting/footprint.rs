@@ -11,7 +11,6 @@ use super::rect::Rect;
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
 use crate::scene_in::Scene;
-use crate::tracing::Hit;
 use crate::water_model::{ExactSurface, WaterModel};
 
 /// Stream tag of the footprints' random numbers: distinct from the renderer's (which uses the
@@ -190,18 +189,23 @@ pub fn footprint_with(
                 (y + k / side).saturating_sub(radius),
             )
         };
-        let Some((start, sample, tmin)) =
+        let Some((water, sample)) =
             reflected_sample(water_model, scene, model, bx, by, width, height, &mut rng)
         else {
             continue;
         };
+        let start = water.start;
         // A ray that cannot reach the plane cannot land on it: no need to trace it, and one
         // that can need not look beyond it (a thousandth further: the face's triangles lie
         // within a ten-thousandth of the distance of its plane).
         let Some(t_plane) = plane.distance(start, sample.wi) else {
             continue;
         };
-        if let Some(hit) = first_surface(scene, start, sample.wi, tmin, t_plane * 1.001) {
+        // Area lights already in the scene are not geometry and do not occlude: the fit asks
+        // what a light on the plane would show, and an existing light coplanar with its wall
+        // must not hide the wall (it would, by rounding, for about half the rays). The bound
+        // lets the traversal skip everything beyond the plane.
+        if let Some(hit) = water.reflected_hit(scene, sample.wi, t_plane * 1.001) {
             if plane.contains_triangle(scene, hit.triangle) {
                 fp.points.push(plane.coords(start + sample.wi * hit.t));
                 fp.weights.push(sample.weight);
@@ -209,18 +213,4 @@ pub fn footprint_with(
         }
     }
     fp
-}
-
-/// The closest triangle hit before `tmax` (bounded, so the traversal skips everything beyond
-/// the plane). Area lights already in the scene are not geometry and do not occlude: the fit
-/// asks what a light on the plane would show, and an existing light coplanar with its wall
-/// must not hide the wall (it would, by rounding, for about half the rays).
-fn first_surface(
-    scene: &Scene,
-    origin: glam::Vec3,
-    dir: glam::Vec3,
-    tmin: f32,
-    tmax: f32,
-) -> Option<Hit> {
-    scene.tracer.closest_hit(origin, dir, tmin, tmax)
 }

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use crate::optics::ReflectionModel;
 use crate::plane::Plane;
 use crate::random::Rng;
-use crate::render::{trace, SceneHit};
+use crate::render::{trace, SceneHit, WaterPoint};
 use crate::scene_in::Scene;
 use crate::water_model::WaterModel;
 
@@ -204,14 +204,14 @@ pub fn find_plane(
     let mut faces: Vec<FaceHits> = Vec::new();
     let (mut rays, mut water_hits) = (0u32, 0u32);
     for _ in 0..samples {
-        let Some((start, sample, tmin)) =
+        let Some((water, sample)) =
             reflected_sample(water_model, scene, model, x, y, width, height, &mut rng)
         else {
             continue;
         };
-        let wi = sample.wi;
+        let (start, wi) = (water.start, sample.wi);
         rays += 1;
-        let SceneHit::Surface(hit) = trace(scene, &[], start, wi, tmin) else {
+        let SceneHit::Surface(hit) = trace(scene, &[], start, wi, water.tmin(wi)) else {
             continue;
         };
         if scene.is_water[hit.triangle as usize] {
@@ -275,9 +275,9 @@ pub fn find_plane(
 /// camera rays and shares each among several lobe samples, which changes the noise but not
 /// the expectation): the reflected ray's origin together with the lobe sample, or `None` when
 /// the sample reflects nothing (the jittered ray misses the water, or the lobe sample is below
-/// the surface), and the distance along the ray before which it ignores what it hits
-/// ([`WaterPoint::tmin`](crate::render::WaterPoint::tmin)). Draws four numbers from `rng`
-/// whatever happens: the jitter, then the lobe's.
+/// the surface). The water point says where the reflected ray starts and what it ignores
+/// ([`WaterPoint::tmin`]). Draws four numbers from `rng` whatever happens: the jitter, then
+/// the lobe's.
 #[allow(clippy::too_many_arguments)]
 pub fn reflected_sample(
     water_model: &dyn WaterModel,
@@ -288,11 +288,11 @@ pub fn reflected_sample(
     width: u32,
     height: u32,
     rng: &mut Rng,
-) -> Option<(Vec3, crate::optics::LobeSample, f32)> {
+) -> Option<(WaterPoint, crate::optics::LobeSample)> {
     let jx = x as f32 + rng.next_f32();
     let jy = y as f32 + rng.next_f32();
     let u = Vec2::new(rng.next_f32(), rng.next_f32());
     let water = water_model.water_point(scene, jx, jy, width, height)?;
     let sample = water_model.reflect(&water, model, u)?;
-    Some((water.start, sample, water.tmin(sample.wi)))
+    Some((water, sample))
 }

@@ -11,6 +11,7 @@ mod nodes;
 mod water;
 
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use glam::{DVec3, Vec3};
 
@@ -21,7 +22,7 @@ pub use nodes::{world_instances, NodeInstance};
 pub use water::{gloss_from_roughness, roughness_from_gloss, Water, DEFAULT_GLOSS, WATER_IOR};
 
 use crate::settings::Setting;
-use crate::tracing::{Tracer, Triangle};
+use crate::tracing::{Hit, Tracer, Triangle};
 use crate::{Error, Result};
 
 /// What the user chose on the command line about the scene.
@@ -70,7 +71,9 @@ pub struct Scene {
     pub sources: Vec<TriangleSource>,
     /// True for triangles of the water node.
     pub is_water: Vec<bool>,
-    /// The BVH over `triangles`.
+    /// The BVH over `triangles`: a caller that changes them rebuilds it. (The BVH over the
+    /// triangles that are not water, [`Scene::closest_hit_above_water`], is built once, on
+    /// first use, from the triangles as they are then.)
     pub tracer: Tracer,
     /// Rect lights found in the scene.
     pub area_lights: Vec<AreaLight>,
@@ -80,6 +83,52 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Node names by index (`None` where unnamed), for messages and reports.
     pub node_names: Vec<Option<String>>,
+    /// The BVH over every triangle but the water's, built on first use
+    /// ([`Scene::closest_hit_above_water`]).
+    above_water: OnceLock<AboveWater>,
+}
+
+/// A BVH over the triangles that are not water, and each one's index in [`Scene::triangles`].
+struct AboveWater {
+    tracer: Tracer,
+    index: Vec<u32>,
+}
+
+impl Scene {
+    /// The closest hit of a ray that runs above every water triangle between `tmin` and `tmax`
+    /// (a statistical water model's reflected ray past the crests,
+    /// [`crate::render::WaterPoint::reflected_hit`]): the same hit as [`Scene::tracer`] gives,
+    /// found among the other triangles alone. A ray leaving a wave mesh at a grazing angle
+    /// otherwise walks the mesh's boxes for metres, testing triangles it cannot hit.
+    pub fn closest_hit_above_water(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<Hit> {
+        let dry = self.above_water.get_or_init(|| {
+            let index: Vec<u32> = (0..self.triangles.len() as u32)
+                .filter(|&i| !self.is_water[i as usize])
+                .collect();
+            let triangles: Vec<Triangle> = index
+                .iter()
+                .map(|&i| Triangle {
+                    vertices: self.triangles[i as usize],
+                })
+                .collect();
+            AboveWater {
+                tracer: Tracer::new(&triangles),
+                index,
+            }
+        });
+        dry.tracer
+            .closest_hit(origin, dir, tmin, tmax)
+            .map(|hit| Hit {
+                triangle: dry.index[hit.triangle as usize],
+                ..hit
+            })
+    }
 }
 
 fn check_override(value: Option<f32>, what: Setting, min_exclusive: f32) -> Result<()> {
@@ -269,6 +318,7 @@ pub fn load_from_bytes(
         dropped_triangles: tris.dropped,
         warnings,
         node_names,
+        above_water: OnceLock::new(),
     })
 }
 

@@ -269,9 +269,7 @@ pub(super) fn trace_samples(
                     // A thousandth further: a face's triangles lie within a ten-thousandth
                     // of the distance of its plane.
                     let tmax = reach * 1.001;
-                    let hit = scene
-                        .tracer
-                        .closest_hit(water.start, s.wi, water.tmin(s.wi), tmax);
+                    let hit = water.reflected_hit(scene, s.wi, tmax);
                     let mut lobe_cell = None;
                     for (k, plane) in planes.iter().enumerate() {
                         let g = &gauss[k];
