@@ -19,8 +19,7 @@ const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
 /// Tries to explain light k as two lights on its plane, side by side or one above the other
 /// (overlapping streaks merge into one region, method §5 and the paper's §5.3): each
 /// candidate starts from the rectangle cut in half and is fitted coarsely, the other lights
-/// held. Returns the
-/// candidate with the lowest row-summed cost when it is below
+/// held. Returns the candidate with the lowest row-summed cost when it is below
 /// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, and the two edges that face each
 /// other (the first light's, then the second's, the new light last in the state). This only
 /// decides whether and which way to split: where the two lights meet is
