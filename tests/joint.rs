@@ -640,3 +640,76 @@ fn all_pixels_reads_the_whole_region() {
         "{e:?} {r}"
     );
 }
+
+/// The joint fit reports the lights it explained as two (`JointOutcome::splits`), and a fit
+/// told them (`JointOptions::known_splits`, as the overlap refit is told the first fit's)
+/// tries each only that way: on the stacked sample from the reflections alone, the one start
+/// light is split one above the other; told so, the fit makes the same lights to the last
+/// bit (the same samples: only the side-by-side trial is left out); told "side by side", it
+/// never cuts the light the other way.
+#[test]
+fn a_known_split_is_tried_only_its_way() {
+    use streaklight::fitting::joint::{fit_joint, JointOptions, Split, SplitWay};
+    use streaklight::fitting::{fit_paper, FitOptions};
+    use streaklight::optics::ReflectionModel;
+    let scene = sample_scene("scene.gltf", None);
+    let photo = sample_photo("stacked.png");
+    let water = water(&scene, &photo);
+    let observations = observations(&photo, &water);
+    let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
+    let paper = fit_paper(
+        &scene,
+        &photo,
+        &water,
+        &observations,
+        &FitOptions {
+            samples: 256,
+            seed: 1,
+            model,
+        },
+    )
+    .expect("paper fit");
+    assert_eq!(paper.lights.len(), 1, "the paper fit makes one light");
+    let fit = |known: &[Split]| {
+        fit_joint(
+            &scene,
+            &photo,
+            &water,
+            &observations,
+            &paper.lights,
+            &JointOptions {
+                samples: 32,
+                direct_view: false,
+                known_splits: known,
+                ..JointOptions::new(model, 1)
+            },
+        )
+        .expect("joint fit")
+    };
+    let free = fit(&[]);
+    let stacked = Split {
+        light: 0,
+        way: SplitWay::Stacked,
+    };
+    assert_eq!(free.splits, [stacked]);
+    assert_eq!(free.lights.len(), 2);
+    let told = fit(&[stacked]);
+    assert_eq!(told.splits, free.splits);
+    for (a, b) in told.lights.iter().zip(&free.lights) {
+        assert_eq!(
+            (a.rect(), a.radiance),
+            (b.rect(), b.radiance),
+            "the same lights"
+        );
+    }
+    let side = Split {
+        light: 0,
+        way: SplitWay::SideBySide,
+    };
+    let other = fit(&[side]);
+    assert!(
+        other.splits.iter().all(|s| s.way == SplitWay::SideBySide),
+        "{:?}",
+        other.splits
+    );
+}

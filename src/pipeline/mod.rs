@@ -25,7 +25,7 @@ pub use water_choice::{
 
 use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
-use crate::fitting::joint::{fit_joint_with, JointOptions, Uncertainty};
+use crate::fitting::joint::{fit_joint_with, JointOptions, Split, Uncertainty};
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -212,6 +212,7 @@ pub fn fit(
         },
         timings: Vec::new(),
         modelled: Vec::new(),
+        splits: Vec::new(),
     };
     let water_model = if observations.is_empty() {
         match settings.water {
@@ -271,6 +272,9 @@ struct Found {
     timings: Vec<(String, f64)>,
     /// The last joint fit's expected image (its fitted pixels and their modelled radiance).
     modelled: Vec<(u32, [f32; 3])>,
+    /// The start lights the last joint fit explained as two: an overlap refit from the same
+    /// start tries each only that way.
+    splits: Vec<Split>,
 }
 
 impl Found {
@@ -359,6 +363,7 @@ impl Run<'_> {
         found.lights = outcome.lights_with_statuses();
         found.uncertainties = outcome.uncertainty;
         found.modelled = outcome.modelled;
+        found.splits = outcome.splits;
         found.warnings.extend(outcome.warnings);
         Ok(())
     }
@@ -399,9 +404,11 @@ impl Run<'_> {
             },
             reading.samples
         ));
+        let known = std::mem::take(&mut found.splits);
         let refit = JointOptions {
             samples: reading.samples,
             checkerboard: !reading.all_pixels,
+            known_splits: &known,
             ..*options
         };
         found.reading = Some(reading);
@@ -442,6 +449,7 @@ impl Run<'_> {
         found.warnings.extend(estimate.warnings);
         found.timings = estimate.timings;
         found.modelled = estimate.modelled;
+        found.splits = estimate.splits;
         let at_estimate = JointOptions {
             model: ReflectionModel {
                 gloss: estimate.gloss,

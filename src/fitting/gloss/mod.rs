@@ -84,7 +84,7 @@ pub(super) mod search;
 
 use std::time::Instant;
 
-use super::joint::{fit_joint, JointOptions, Uncertainty};
+use super::joint::{fit_joint, JointOptions, Split, Uncertainty};
 use super::{fit_paper, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -216,6 +216,9 @@ pub struct GlossEstimate {
     /// The final joint fit's expected image: its fitted water pixels with their modelled
     /// radiance ([`super::joint::JointOutcome::modelled`]).
     pub modelled: Vec<(u32, [f32; 3])>,
+    /// The start lights the final fit explained as two
+    /// ([`super::joint::JointOutcome::splits`]).
+    pub splits: Vec<Split>,
 }
 
 /// Estimates the water's gloss from the photo and fits the lights with it (see the module
@@ -356,6 +359,7 @@ pub fn estimate_gloss(
         warnings,
         timings,
         modelled: final_fit.modelled,
+        splits: final_fit.splits,
     })
 }
 

@@ -122,6 +122,7 @@ mod split;
 mod uncertainty;
 
 pub use samples::effective_samples;
+pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty};
 
 use direct::direct_pixels;
@@ -154,6 +155,10 @@ pub struct JointOptions<'a> {
     /// Try explaining each light as two (overlapping streaks), keeping the split when it
     /// fits the photo far better.
     pub split: bool,
+    /// Lights a fit before split, from the same start on the same photo: each is tried only
+    /// the way that fit cut it (an overlap refit over more samples saves the other way's
+    /// trial). Empty by default.
+    pub known_splits: &'a [Split],
     /// The gloss whose lobe decides which pixels around the streaks are fitted (`None`: the
     /// model's). Fits under different glosses are comparable only over the same pixels, so a
     /// gloss search fixes it to the broadest lobe it will try.
@@ -189,6 +194,7 @@ impl JointOptions<'_> {
             sweeps: 14,
             checkerboard: true,
             split: true,
+            known_splits: &[],
             region_gloss: None,
             region_water: None,
             repeats: 1,
@@ -231,6 +237,9 @@ pub struct JointOutcome {
     /// Things the user should know: the lights dropped because the photo cannot tell them
     /// from nothing (`significance`), with why.
     pub warnings: Vec<String>,
+    /// The start lights the fit explained as two, and which way
+    /// ([`JointOptions::known_splits`] of a refit).
+    pub splits: Vec<Split>,
 }
 
 impl JointOutcome {
@@ -306,6 +315,7 @@ pub fn fit_joint_with(
             timings: Vec::new(),
             modelled: Vec::new(),
             warnings: Vec::new(),
+            splits: Vec::new(),
         });
     }
     // Starts far from the lights' direct images are moved onto them (`direct_start`).
@@ -439,12 +449,13 @@ pub fn fit_joint_with(
     ));
     let t1 = Instant::now();
     let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
-    let (first, replay) = optimise(
+    let (first, replay, splits) = optimise(
         &mut problem,
         start,
         &mut extents,
         options.sweeps,
         options.split,
+        options.known_splits,
         &|origin, draw| fresh_set(0, origin, draw),
         options.progress,
     );
@@ -597,6 +608,7 @@ pub fn fit_joint_with(
         ],
         modelled,
         warnings,
+        splits,
     })
 }
 

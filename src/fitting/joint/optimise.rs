@@ -13,7 +13,7 @@
 use super::boundary::{search_boundary, CANDIDATE_SWEEPS};
 use super::problem::{Problem, State};
 use super::samples::{sample_extent, PlaneSamples};
-use super::split::try_split;
+use super::split::{try_split, Split, SplitWay};
 use crate::fitting::rect::Rect;
 use crate::fitting::{EdgeSide, EdgeStatus, FittedLight};
 use crate::progress::Reporter;
@@ -24,17 +24,21 @@ use crate::progress::Reporter;
 /// the boundary between the two placed by [`search_boundary`], and another descent. Returns
 /// the optimum and the state its last descent started from (the start, or the split lights
 /// after their boundary search): a repeat on other samples starts there (see
-/// [`Problem::replay`]). `progress` hears each split (so that a fit announced with N lights
-/// that ends with more says why) and the count of boundary candidates descended.
+/// [`Problem::replay`]), and the splits made. A light of `known` (split by a fit before, from
+/// the same start) is tried only the way that fit cut it. `progress` hears each split (so
+/// that a fit announced with N lights that ends with more says why) and the count of
+/// boundary candidates descended.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn optimise(
     problem: &mut Problem,
     start: &[FittedLight],
     extents: &mut Vec<Option<Rect>>,
     sweeps: u32,
     split: bool,
+    known: &[Split],
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     progress: Reporter<'_>,
-) -> (State, State) {
+) -> (State, State, Vec<Split>) {
     let rects: Vec<Rect> = start
         .iter()
         .zip(extents.iter())
@@ -63,11 +67,17 @@ pub(super) fn optimise(
     );
     let mut replay = st.clone();
     problem.descend(&mut st, extents, sweeps);
+    let mut splits = Vec::new();
     if split && problem.structured(&st) {
         for k in 0..start.len() {
-            let Some((trial, inner)) = try_split(problem, &st, k, extents) else {
+            let ways = match known.iter().find(|s| s.light == k) {
+                Some(s) => std::slice::from_ref(&s.way),
+                None => &SplitWay::ALL[..],
+            };
+            let Some((trial, way, inner)) = try_split(problem, &st, k, extents, ways) else {
                 continue;
             };
+            splits.push(Split { light: k, way });
             st = trial;
             let b = st.rects.len() - 1;
             // The two lights of a split read independent samples: with one set shared, the
@@ -109,7 +119,7 @@ pub(super) fn optimise(
             problem.descend(&mut st, extents, sweeps);
         }
     }
-    (st, replay)
+    (st, replay, splits)
 }
 
 impl Problem {

@@ -16,37 +16,60 @@ const SPLIT_TRIAL_SWEEPS: u32 = 8;
 /// freedom to place edges where that noise happens to be large.
 const SPLIT_MIN_ROW_COST_RATIO: f64 = 0.5;
 
-/// Tries to explain light k as two lights on its plane, side by side or one above the other
-/// (overlapping streaks merge into one region, method §5 and the paper's §5.3): each
-/// candidate starts from the rectangle cut in half and is fitted coarsely, the other lights
-/// held. Returns the candidate with the lowest row-summed cost when it is below
-/// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, and the two edges that face each
-/// other (the first light's, then the second's, the new light last in the state). This only
-/// decides whether and which way to split: where the two lights meet is
+/// Which way a light is cut in two.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplitWay {
+    /// One light above the other.
+    Stacked,
+    /// Side by side.
+    SideBySide,
+}
+
+impl SplitWay {
+    /// Both ways, in the order they are tried.
+    pub const ALL: [SplitWay; 2] = [SplitWay::Stacked, SplitWay::SideBySide];
+}
+
+/// A light that a joint fit explained as two: its index among the fit's start lights, and
+/// which way it was cut ([`super::JointOutcome::splits`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Split {
+    /// The start light's index.
+    pub light: usize,
+    /// The way it was cut.
+    pub way: SplitWay,
+}
+
+/// Tries to explain light k as two lights on its plane, each way of `ways` (one above the
+/// other, side by side; overlapping streaks merge into one region, method §5 and the paper's
+/// §5.3): each candidate starts from the rectangle cut in half and is fitted coarsely, the
+/// other lights held. Returns the candidate with the lowest row-summed cost when it is below
+/// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, its way, and the two edges that
+/// face each other (the first light's, then the second's, the new light last in the state).
+/// This only decides whether and which way to split: where the two lights meet is
 /// [`search_boundary`](super::boundary::search_boundary)'s work.
 pub(super) fn try_split(
     problem: &Problem,
     st: &State,
     k: usize,
     extents: &[Option<Rect>],
-) -> Option<(State, [EdgeSide; 2])> {
+    ways: &[SplitWay],
+) -> Option<(State, SplitWay, [EdgeSide; 2])> {
     let r = st.rects[k];
-    let halves = [
-        // One above the other.
-        (
-            r.with_edge(EdgeSide::Top, 0.5 * (r.v_min + r.v_max)),
-            r.with_edge(EdgeSide::Bottom, 0.5 * (r.v_min + r.v_max)),
-            [EdgeSide::Top, EdgeSide::Bottom],
-        ),
-        // Side by side.
-        (
-            r.with_edge(EdgeSide::Right, 0.5 * (r.u_min + r.u_max)),
-            r.with_edge(EdgeSide::Left, 0.5 * (r.u_min + r.u_max)),
-            [EdgeSide::Right, EdgeSide::Left],
-        ),
-    ];
-    let mut best: Option<(State, [EdgeSide; 2], f64)> = None;
-    for (first, second, inner) in halves {
+    let mut best: Option<(State, SplitWay, [EdgeSide; 2], f64)> = None;
+    for &way in ways {
+        let (first, second, inner) = match way {
+            SplitWay::Stacked => (
+                r.with_edge(EdgeSide::Top, 0.5 * (r.v_min + r.v_max)),
+                r.with_edge(EdgeSide::Bottom, 0.5 * (r.v_min + r.v_max)),
+                [EdgeSide::Top, EdgeSide::Bottom],
+            ),
+            SplitWay::SideBySide => (
+                r.with_edge(EdgeSide::Right, 0.5 * (r.u_min + r.u_max)),
+                r.with_edge(EdgeSide::Left, 0.5 * (r.u_min + r.u_max)),
+                [EdgeSide::Right, EdgeSide::Left],
+            ),
+        };
         let mut set_of = st.set_of.clone();
         let mut pinned = st.pinned.clone();
         let mut rects = st.rects.clone();
@@ -75,11 +98,11 @@ pub(super) fn try_split(
         let both_lit = [k, trial.rects.len() - 1]
             .iter()
             .all(|&j| trial.radiance[j].iter().any(|&l| l > 0.0));
-        if both_lit && best.as_ref().is_none_or(|(_, _, b)| c < *b) {
-            best = Some((trial, inner, c));
+        if both_lit && best.as_ref().is_none_or(|(_, _, _, b)| c < *b) {
+            best = Some((trial, way, inner, c));
         }
     }
     let before = problem.row_cost(st);
-    best.filter(|(_, _, c)| *c < SPLIT_MIN_ROW_COST_RATIO * before)
-        .map(|(trial, inner, _)| (trial, inner))
+    best.filter(|(_, _, _, c)| *c < SPLIT_MIN_ROW_COST_RATIO * before)
+        .map(|(trial, way, inner, _)| (trial, way, inner))
 }

@@ -38,7 +38,7 @@ pub use uncertainty::{correlation_area, parameter_slopes, widen, MAX_LAG};
 
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
-use super::joint::{fit_joint_with, JointOptions, Uncertainty};
+use super::joint::{fit_joint_with, JointOptions, Split, Uncertainty};
 use super::{fit_paper_with, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::photo_in::Photo;
@@ -102,6 +102,9 @@ pub struct SlopeEstimate {
     /// The final fit's residual correlation area, pixels per independent residual
     /// ([`correlation_area`]): the uncertainties are grown by its square root.
     pub correlation_area: f64,
+    /// The start lights the final fit explained as two
+    /// ([`super::joint::JointOutcome::splits`]).
+    pub splits: Vec<Split>,
 }
 
 /// Estimates the slope variances over `surface` from the start `start_variance` (totals,
@@ -161,6 +164,7 @@ pub fn estimate_slopes(
             timings,
             cost: 0.0,
             correlation_area: 1.0,
+            splits: Vec::new(),
         });
     }
     let start = search_start(&paper_fit, streaks.len(), "waves' slope")?;
@@ -333,6 +337,7 @@ pub fn estimate_slopes(
         timings,
         cost: fit.cost,
         correlation_area: area,
+        splits: fit.splits,
     })
 }
 
