@@ -568,6 +568,45 @@ fn stacked_lights_apart_never_become_a_sliver() {
     }
 }
 
+/// A sample photo over `scene.gltf`, its water and streaks, and the paper fit's lights: the
+/// start of the tests that call the joint fit directly.
+struct PaperStart {
+    scene: streaklight::scene_in::Scene,
+    photo: streaklight::photo_in::Photo,
+    water: Vec<bool>,
+    observations: Vec<streaklight::fitting::StreakObservation>,
+    model: streaklight::optics::ReflectionModel,
+    paper: streaklight::fitting::FitOutcome,
+}
+
+fn paper_start(photo_name: &str) -> PaperStart {
+    let scene = sample_scene("scene.gltf", None);
+    let photo = sample_photo(photo_name);
+    let water = water(&scene, &photo);
+    let observations = observations(&photo, &water);
+    let model = streaklight::optics::ReflectionModel::new(scene.water.gloss, scene.water.ior);
+    let paper = streaklight::fitting::fit_paper(
+        &scene,
+        &photo,
+        &water,
+        &observations,
+        &streaklight::fitting::FitOptions {
+            samples: 256,
+            seed: 1,
+            model,
+        },
+    )
+    .expect("paper fit");
+    PaperStart {
+        scene,
+        photo,
+        water,
+        observations,
+        model,
+        paper,
+    }
+}
+
 /// `--all-pixels`: the joint fit reads every pixel of its region instead of a checkerboard
 /// half. On Table 1 the region then holds twice the pixels (the checkerboard keeps every
 /// second one, so within a few pixels of its border), the lights stay within
@@ -575,25 +614,14 @@ fn stacked_lights_apart_never_become_a_sliver() {
 #[test]
 fn all_pixels_reads_the_whole_region() {
     use streaklight::fitting::joint::{fit_joint, JointOptions};
-    use streaklight::fitting::{fit_paper, FitOptions};
-    use streaklight::optics::ReflectionModel;
-    let scene = sample_scene("scene.gltf", None);
-    let photo = sample_photo("table1.png");
-    let water = water(&scene, &photo);
-    let observations = observations(&photo, &water);
-    let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
-    let paper = fit_paper(
-        &scene,
-        &photo,
-        &water,
-        &observations,
-        &FitOptions {
-            samples: 256,
-            seed: 1,
-            model,
-        },
-    )
-    .expect("paper fit");
+    let PaperStart {
+        scene,
+        photo,
+        water,
+        observations,
+        model,
+        paper,
+    } = paper_start("table1.png");
     let fit = |checkerboard: bool| {
         fit_joint(
             &scene,
@@ -650,25 +678,14 @@ fn all_pixels_reads_the_whole_region() {
 #[test]
 fn a_known_split_is_tried_only_its_way() {
     use streaklight::fitting::joint::{fit_joint, JointOptions, Split, SplitWay};
-    use streaklight::fitting::{fit_paper, FitOptions};
-    use streaklight::optics::ReflectionModel;
-    let scene = sample_scene("scene.gltf", None);
-    let photo = sample_photo("stacked.png");
-    let water = water(&scene, &photo);
-    let observations = observations(&photo, &water);
-    let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
-    let paper = fit_paper(
-        &scene,
-        &photo,
-        &water,
-        &observations,
-        &FitOptions {
-            samples: 256,
-            seed: 1,
-            model,
-        },
-    )
-    .expect("paper fit");
+    let PaperStart {
+        scene,
+        photo,
+        water,
+        observations,
+        model,
+        paper,
+    } = paper_start("stacked.png");
     assert_eq!(paper.lights.len(), 1, "the paper fit makes one light");
     let fit = |known: &[Split]| {
         fit_joint(
