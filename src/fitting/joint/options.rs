@@ -1,0 +1,85 @@
+//! The joint fit's options ([`JointOptions`]) and the limits on its samples.
+
+use super::Split;
+use crate::optics::ReflectionModel;
+use crate::progress::Reporter;
+use crate::water_model::WaterModel;
+
+/// How to refine.
+#[derive(Clone, Copy, Debug)]
+pub struct JointOptions<'a> {
+    /// Lobe samples per pixel of the fitted region. The cost sums over thousands of pixels, so
+    /// far fewer than the photo's own samples suffice.
+    pub samples: u32,
+    /// Seed of the footprints' random numbers.
+    pub seed: u64,
+    /// The water's reflection model.
+    pub model: ReflectionModel,
+    /// Pixels by which each streak is dilated to give the fitted region: the dark water around
+    /// a streak is what pins its edges down.
+    pub margin: u32,
+    /// Coordinate-descent sweeps, at most (each shrinks the search windows; the descent
+    /// stops once they are all at their smallest).
+    pub sweeps: u32,
+    /// Fit every pixel (false) or a checkerboard half of them (true): neighbouring pixels
+    /// carry nearly the same information, and the footprints are most of the cost.
+    pub checkerboard: bool,
+    /// Try explaining each light as two (overlapping streaks), keeping the split when it
+    /// fits the photo far better.
+    pub split: bool,
+    /// Lights a fit before split, from the same start on the same photo: each is tried only
+    /// the way that fit cut it (an overlap refit over more samples saves the other way's
+    /// trial). Empty by default.
+    pub known_splits: &'a [Split],
+    /// The gloss whose lobe decides which pixels around the streaks are fitted (`None`: the
+    /// model's). Fits under different glosses are comparable only over the same pixels, so a
+    /// gloss search fixes it to the broadest lobe it will try.
+    pub region_gloss: Option<f32>,
+    /// The water model whose lobes (at the region gloss) decide which pixels are fitted
+    /// (`None`: the fit's own). A search over the statistical model's slopes fixes it to the
+    /// broadest lobe it will try, as a gloss search fixes [`region_gloss`](Self::region_gloss).
+    pub region_water: Option<&'a dyn WaterModel>,
+    /// Independent fits, each from its own samples, whose mean is the result (at least 1).
+    /// From 2 on, their spread is added to the uncertainties (how far the samples move the
+    /// fit); the mean's own error falls as one over the square root of
+    /// the count.
+    pub repeats: u32,
+    /// Told as each repeat starts, when there are several (silent by default).
+    pub progress: Reporter<'a>,
+    /// Estimate the coefficients with the lobe Gaussian as a control variate (see the module
+    /// doc): the same expectation, far less noise. Off only to measure what it brings.
+    pub control_variate: bool,
+    /// Fit the pixels outside the water that see a light's wall directly too (`direct`):
+    /// where a light is in the photo, its direct image pins its edges to a fraction of a
+    /// pixel. Off, only the water pixels are read.
+    pub direct_view: bool,
+}
+
+impl JointOptions<'_> {
+    /// Defaults for a model and seed.
+    pub fn new(model: ReflectionModel, seed: u64) -> Self {
+        JointOptions {
+            samples: DEFAULT_JOINT_SAMPLES,
+            seed,
+            model,
+            margin: 6,
+            sweeps: 14,
+            checkerboard: true,
+            split: true,
+            known_splits: &[],
+            region_gloss: None,
+            region_water: None,
+            repeats: 1,
+            progress: Reporter::default(),
+            control_variate: true,
+            direct_view: true,
+        }
+    }
+}
+
+/// Default lobe samples per pixel of the joint fit.
+pub const DEFAULT_JOINT_SAMPLES: u32 = 72;
+
+/// The most lobe samples per pixel the joint fit takes: a pixel's stored samples are indexed
+/// in 16 bits (`samples::PlaneSamples::by_v`), and `effective_samples` of this is 32768.
+pub const MAX_JOINT_SAMPLES: u32 = 32_768;
