@@ -11,6 +11,7 @@ use common::pipeline::{
     sample_scenes_in, water,
 };
 use streaklight::convert::{convert, ConvertOptions};
+use streaklight::fitting::joint::{fit_joint, JointOptions, JointOutcome};
 use streaklight::pipeline::{JointSettings, Method};
 use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
@@ -579,6 +580,22 @@ struct PaperStart {
     paper: streaklight::fitting::FitOutcome,
 }
 
+impl PaperStart {
+    /// The joint fit from the paper fit's lights with `options` (its model and seed 1 unless
+    /// `options` says otherwise).
+    fn fit<'a>(&self, options: impl FnOnce(JointOptions<'a>) -> JointOptions<'a>) -> JointOutcome {
+        fit_joint(
+            &self.scene,
+            &self.photo,
+            &self.water,
+            &self.observations,
+            &self.paper.lights,
+            &options(JointOptions::new(self.model, 1)),
+        )
+        .expect("joint fit")
+    }
+}
+
 fn paper_start(photo_name: &str) -> PaperStart {
     let scene = sample_scene("scene.gltf", None);
     let photo = sample_photo(photo_name);
@@ -613,29 +630,8 @@ fn paper_start(photo_name: &str) -> PaperStart {
 /// [`LIGHT0_BOUND`], and the report says which pixels were read.
 #[test]
 fn all_pixels_reads_the_whole_region() {
-    use streaklight::fitting::joint::{fit_joint, JointOptions};
-    let PaperStart {
-        scene,
-        photo,
-        water,
-        observations,
-        model,
-        paper,
-    } = paper_start("table1.png");
-    let fit = |checkerboard: bool| {
-        fit_joint(
-            &scene,
-            &photo,
-            &water,
-            &observations,
-            &paper.lights,
-            &JointOptions {
-                checkerboard,
-                ..JointOptions::new(model, 1)
-            },
-        )
-        .expect("joint fit")
-    };
+    let start = paper_start("table1.png");
+    let fit = |checkerboard: bool| start.fit(|o| JointOptions { checkerboard, ..o });
     let (half, all) = (fit(true), fit(false));
     let ratio = all.pixels as f64 / half.pixels as f64;
     assert!(
@@ -677,31 +673,16 @@ fn all_pixels_reads_the_whole_region() {
 /// never cuts the light the other way.
 #[test]
 fn a_known_split_is_tried_only_its_way() {
-    use streaklight::fitting::joint::{fit_joint, JointOptions, Split, SplitWay};
-    let PaperStart {
-        scene,
-        photo,
-        water,
-        observations,
-        model,
-        paper,
-    } = paper_start("stacked.png");
-    assert_eq!(paper.lights.len(), 1, "the paper fit makes one light");
+    use streaklight::fitting::joint::{Split, SplitWay};
+    let start = paper_start("stacked.png");
+    assert_eq!(start.paper.lights.len(), 1, "the paper fit makes one light");
     let fit = |known: &[Split]| {
-        fit_joint(
-            &scene,
-            &photo,
-            &water,
-            &observations,
-            &paper.lights,
-            &JointOptions {
-                samples: 32,
-                direct_view: false,
-                known_splits: known,
-                ..JointOptions::new(model, 1)
-            },
-        )
-        .expect("joint fit")
+        start.fit(|o| JointOptions {
+            samples: 32,
+            direct_view: false,
+            known_splits: known,
+            ..o
+        })
     };
     let free = fit(&[]);
     let stacked = Split {
