@@ -56,9 +56,11 @@
 //! of the lowest point but the bracket is wider than [`GlossSearch::max_bracket_ln`] (too
 //! wide to trust a parabola over: the cost is skewed), narrow the bracket's wider side. Stop
 //! when the vertex is within the tolerance of the lowest point in a narrow bracket; the
-//! estimate is that vertex. On the samples that took 3 evaluations from the right gloss and 6
-//! or 7 from a start 2 or 2.5 times off, each about 2.5 s on 2 quiet cores, and then one full
-//! joint fit at the estimate (about 3 s): 11 s in all for Table 1.
+//! estimate is that vertex. On the samples that takes 3 evaluations from the right gloss, 7
+//! from a start 2 times off (`gloss1000.png` from 500) and 8 from one 2.5 times off
+//! (`gloss200.png` from 500), each about 3.6 s on 2 quiet cores (most of it the trace of the
+//! fit's footprints, redone at every gloss), and then one full joint fit at the estimate
+//! (about 3.5 s): 15 s in all for Table 1, 33 s for `gloss200.png`.
 //!
 //! # Uncertainty
 //!
@@ -66,9 +68,9 @@
 //! the cost by the residual variance per degree of freedom `s2`, so `sigma(ln e) = sqrt(s2 / k)`.
 //! That is the photo's statistical limit (pixel noise independent): it leaves out the model's
 //! own errors and the Monte Carlo noise of the fits, and is a lower bound. On the samples it
-//! is 0.1-0.2 %, while the estimates (`tests/gloss.rs`) are 205.6 for e = 200, 500.8 for 500
-//! and 1001.2 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3, measured
-//! when the search was written). Read the estimate as good to a few percent. (With the joint
+//! is about 0.04 %, while the estimates (`tests/gloss.rs`) are 199.6 for e = 200, 503.3 for
+//! 500 and 1000.5 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
+//! measured when the search was written). Read the estimate as good to a few percent. (With the joint
 //! fit's own default of 72 samples e = 200 came out 223: see [`SEARCH_SAMPLES`].)
 //!
 //! # Limits
