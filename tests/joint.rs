@@ -11,7 +11,7 @@ use common::pipeline::{
     sample_scenes_in, water,
 };
 use streaklight::convert::{convert, ConvertOptions};
-use streaklight::fitting::joint::{fit_joint, JointOptions, JointOutcome};
+use streaklight::fitting::joint::{fit_joint, JointOptions, JointOutcome, PixelShare};
 use streaklight::pipeline::{JointSettings, Method};
 use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
@@ -631,8 +631,8 @@ fn paper_start(photo_name: &str) -> PaperStart {
 #[test]
 fn all_pixels_reads_the_whole_region() {
     let start = paper_start("table1.png");
-    let fit = |checkerboard: bool| start.fit(|o| JointOptions { checkerboard, ..o });
-    let (half, all) = (fit(true), fit(false));
+    let fit = |pixels: PixelShare| start.fit(|o| JointOptions { pixels, ..o });
+    let (half, all) = (fit(PixelShare::Checkerboard), fit(PixelShare::All));
     let ratio = all.pixels as f64 / half.pixels as f64;
     assert!(
         (ratio - 2.0).abs() < 0.01,

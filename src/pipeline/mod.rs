@@ -329,7 +329,7 @@ impl Run<'_> {
             progress: self.progress,
             repeats: j.repeats,
             samples: reading.samples,
-            checkerboard: !reading.all_pixels,
+            pixels: reading.share(),
             direct_view: j.direct_view,
             ..JointOptions::new(self.paper.model, self.paper.seed)
         }
@@ -407,7 +407,7 @@ impl Run<'_> {
         let known = std::mem::take(&mut found.splits);
         let refit = JointOptions {
             samples: reading.samples,
-            checkerboard: !reading.all_pixels,
+            pixels: reading.share(),
             known_splits: &known,
             ..*options
         };

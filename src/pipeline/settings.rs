@@ -4,7 +4,7 @@
 
 use super::water_choice::WaterChoice;
 use crate::fitting::gloss::{GlossSearch, SEARCH_SAMPLES};
-use crate::fitting::joint::DEFAULT_JOINT_SAMPLES;
+use crate::fitting::joint::{PixelShare, DEFAULT_JOINT_SAMPLES};
 use crate::fitting::DEFAULT_SAMPLES;
 use crate::optics::Shadowing;
 use crate::settings::Setting;
@@ -88,6 +88,17 @@ pub struct Reading {
     /// Every pixel of the fitted region instead of a checkerboard half: about twice the time,
     /// less of both the samples' and the photo's noise.
     pub all_pixels: bool,
+}
+
+impl Reading {
+    /// The joint fit's share of the pixels.
+    pub fn share(&self) -> PixelShare {
+        if self.all_pixels {
+            PixelShare::All
+        } else {
+            PixelShare::Checkerboard
+        }
+    }
 }
 
 /// The reading lights that share a streak are fitted again with by default.

@@ -43,6 +43,12 @@
 //!   (infinite cost). The fits of the search run fewer coordinate-descent sweeps than a
 //!   final fit ([`GlossSearch::search_sweeps`]): the cost at the optimum moves by 0.3 % and
 //!   uniformly across `e`.
+//! * The fits read a quarter of the region's pixels, one of each 2 x 2 block
+//!   ([`GlossSearch::search_pixels`]), half of what a final fit reads: where the minimum lies
+//!   is set by how the streaks' profiles change with `e`, which every part of a streak shows
+//!   alike, not by how closely each candidate's lights are pinned. Against the checkerboard
+//!   the estimates moved by under 2 % (Table 3 from e = 100: 502.3 instead of 511.9; the
+//!   others within 0.6 %) and an evaluation took 1.6 s instead of 3.6 s.
 //!
 //! # Search
 //!
@@ -58,9 +64,9 @@
 //! when the vertex is within the tolerance of the lowest point in a narrow bracket; the
 //! estimate is that vertex. On the samples that takes 3 evaluations from the right gloss, 7
 //! from a start 2 times off (`gloss1000.png` from 500) and 8 from one 2.5 times off
-//! (`gloss200.png` from 500), each about 3.6 s on 2 quiet cores (most of it the trace of the
+//! (`gloss200.png` from 500), each about 1.6 s on 2 quiet cores (most of it the trace of the
 //! fit's footprints, redone at every gloss), and then one full joint fit at the estimate
-//! (about 3.5 s): 15 s in all for Table 1, 33 s for `gloss200.png`.
+//! (about 3.3 s): 8.6 s in all for Table 1, 17 s for `gloss200.png`.
 //!
 //! # Uncertainty
 //!
@@ -68,8 +74,8 @@
 //! the cost by the residual variance per degree of freedom `s2`, so `sigma(ln e) = sqrt(s2 / k)`.
 //! That is the photo's statistical limit (pixel noise independent): it leaves out the model's
 //! own errors and the Monte Carlo noise of the fits, and is a lower bound. On the samples it
-//! is about 0.04 %, while the estimates (`tests/gloss.rs`) are 199.6 for e = 200, 503.3 for
-//! 500 and 1000.5 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
+//! is about 0.06 %, while the estimates (`tests/gloss.rs`) are 200.4 for e = 200, 504.7 for
+//! 500 and 1006.2 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
 //! measured when the search was written). Read the estimate as good to a few percent. (With the joint
 //! fit's own default of 72 samples e = 200 came out 223: see [`SEARCH_SAMPLES`].)
 //!
@@ -86,7 +92,7 @@ pub(super) mod search;
 
 use std::time::Instant;
 
-use super::joint::{fit_joint, JointOptions, Split, Uncertainty};
+use super::joint::{fit_joint, JointOptions, PixelShare, Split, Uncertainty};
 use super::{fit_paper, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -118,6 +124,8 @@ pub struct GlossSearch {
     pub search_samples: u32,
     /// Coordinate-descent sweeps of the search's joint fits.
     pub search_sweeps: u32,
+    /// The pixels the search's joint fits read.
+    pub search_pixels: PixelShare,
 }
 
 /// Joint-fit samples per pixel of the search and, by default, of the final fit (module doc:
@@ -137,6 +145,7 @@ impl Default for GlossSearch {
             max_evaluations: 12,
             search_samples: SEARCH_SAMPLES,
             search_sweeps: 6,
+            search_pixels: PixelShare::Quarter,
         }
     }
 }
@@ -465,6 +474,7 @@ impl Cost<'_> {
             &JointOptions {
                 samples: self.options.search_samples,
                 sweeps: self.options.search_sweeps,
+                pixels: self.options.search_pixels,
                 // A wrong gloss leaves a structured residual too: splitting lights there
                 // would fit the lobe's error, not a second light.
                 split: false,

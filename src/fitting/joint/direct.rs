@@ -32,6 +32,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::kernel::POINT_CELL;
+use super::options::PixelShare;
 use super::problem::Problem;
 use super::samples::CAMERA_STRATA;
 use crate::fitting::light_plane::LightPlane;
@@ -50,8 +51,7 @@ enum Corner {
     Other,
 }
 
-/// The pixels outside the water (every second one on a checkerboard when `checkerboard`, as
-/// the water pixels are read) that see a light's plane inside its region of interest `roi[k]`
+/// The pixels outside the water (those of them `share` reads, as the water pixels are read) that see a light's plane inside its region of interest `roi[k]`
 /// directly. A pixel is taken when a camera ray through one of its corners meets such a
 /// plane first and none meets the water (a pixel the water's far edge crosses mixes
 /// reflections in, which its direct samples would not model). Only the image box where the
@@ -63,7 +63,7 @@ pub(super) fn direct_pixels(
     width: u32,
     height: u32,
     water: &[bool],
-    checkerboard: bool,
+    share: PixelShare,
 ) -> Vec<u32> {
     let Some((x0, y0, x1, y1)) = image_box(scene, planes, roi, width, height) else {
         return Vec::new();
@@ -81,7 +81,7 @@ pub(super) fn direct_pixels(
     for y in y0..=y1 {
         for x in x0..=x1 {
             let i = (y * width + x) as usize;
-            if water[i] || (checkerboard && !(x + y).is_multiple_of(2)) {
+            if water[i] || !share.reads(x, y) {
                 continue;
             }
             let c = ((y - y0) as usize) * cw + (x - x0) as usize;

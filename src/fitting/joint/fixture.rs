@@ -45,7 +45,7 @@ pub(super) fn table3_light0() -> Table3Light0 {
         &water,
         &used,
         6,
-        true,
+        super::PixelShare::Checkerboard,
     )
     .into_iter()
     .step_by(8)

@@ -122,7 +122,7 @@ mod significance;
 mod split;
 mod uncertainty;
 
-pub use options::{JointOptions, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
+pub use options::{JointOptions, PixelShare, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
 pub use samples::effective_samples;
 pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty};
@@ -296,7 +296,7 @@ pub fn fit_joint_with(
         water,
         &used,
         options.margin,
-        options.checkerboard,
+        options.pixels,
     );
     // The pixels that see the lights' walls directly follow the water pixels.
     let first_direct = pixels.len();
@@ -308,7 +308,7 @@ pub fn fit_joint_with(
             photo.width,
             photo.height,
             water,
-            options.checkerboard,
+            options.pixels,
         ));
     }
     let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {

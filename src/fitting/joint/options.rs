@@ -21,9 +21,9 @@ pub struct JointOptions<'a> {
     /// Coordinate-descent sweeps, at most (each shrinks the search windows; the descent
     /// stops once they are all at their smallest).
     pub sweeps: u32,
-    /// Fit every pixel (false) or a checkerboard half of them (true): neighbouring pixels
-    /// carry nearly the same information, and the footprints are most of the cost.
-    pub checkerboard: bool,
+    /// Which pixels of the region are fitted ([`PixelShare`]): neighbouring pixels carry
+    /// nearly the same information, and the footprints are most of the cost.
+    pub pixels: PixelShare,
     /// Try explaining each light as two (overlapping streaks), keeping the split when it
     /// fits the photo far better.
     pub split: bool,
@@ -64,7 +64,7 @@ impl JointOptions<'_> {
             model,
             margin: 6,
             sweeps: 14,
-            checkerboard: true,
+            pixels: PixelShare::Checkerboard,
             split: true,
             known_splits: &[],
             region_gloss: None,
@@ -73,6 +73,31 @@ impl JointOptions<'_> {
             progress: Reporter::default(),
             control_variate: true,
             direct_view: true,
+        }
+    }
+}
+
+/// Which pixels of its region a joint fit reads: the same share of the water pixels and of
+/// the pixels that see a light directly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelShare {
+    /// Every pixel.
+    All,
+    /// Every second pixel, on a checkerboard: the fit's default.
+    Checkerboard,
+    /// Every fourth pixel, one of each 2 x 2 block (even column, even row): enough for a
+    /// search that compares the costs of fits over the same pixels, where where the minimum
+    /// lies matters and not how well each fit pins its lights.
+    Quarter,
+}
+
+impl PixelShare {
+    /// Whether the pixel in column `x`, row `y` is read.
+    pub fn reads(self, x: u32, y: u32) -> bool {
+        match self {
+            PixelShare::All => true,
+            PixelShare::Checkerboard => (x + y).is_multiple_of(2),
+            PixelShare::Quarter => x.is_multiple_of(2) && y.is_multiple_of(2),
         }
     }
 }

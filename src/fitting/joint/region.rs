@@ -9,6 +9,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use super::descent::first_window;
+use super::options::PixelShare;
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::fitting::{FittedLight, StreakObservation};
@@ -33,7 +34,7 @@ pub(super) fn region(
     water: &[bool],
     streaks: &[&StreakObservation],
     margin: u32,
-    checkerboard: bool,
+    share: PixelShare,
 ) -> Vec<u32> {
     let (w, h) = (photo.width as i64, photo.height as i64);
     let m = margin as i64;
@@ -61,7 +62,7 @@ pub(super) fn region(
             ));
         }
     }
-    let keep = |i: usize| water[i] && (!checkerboard || (i as i64 % w + i as i64 / w) % 2 == 0);
+    let keep = |i: usize| water[i] && share.reads((i as i64 % w) as u32, (i as i64 / w) as u32);
     let mut pixels: Vec<u32> = (0..(w * h) as usize)
         .filter(|&i| mark[i] && keep(i))
         .map(|i| i as u32)

@@ -148,7 +148,7 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
         PHOTO_SIZE,
         PHOTO_SIZE,
         &water,
-        true,
+        PixelShare::Checkerboard,
     );
     // 4.8 x 4.8 m at 10 m, 600 pixels over 2 tan(30 deg) 10 m: about 250 pixels a side, half of
     // them on the checkerboard.
@@ -176,7 +176,7 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
         PHOTO_SIZE,
         PHOTO_SIZE,
         &water,
-        true,
+        PixelShare::Checkerboard,
     );
     assert!(none.is_empty(), "{} pixels", none.len());
 }
