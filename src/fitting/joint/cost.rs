@@ -72,6 +72,14 @@ impl Problem {
         self.residual_squares(st, true)
     }
 
+    /// The residual variance per pixel and channel: the cost over its degrees of freedom
+    /// (three channels a pixel, seven parameters a light), at least the smallest positive
+    /// number.
+    pub(super) fn residual_variance(&self, st: &State) -> f64 {
+        let dof = (self.n() * 3).saturating_sub(7 * st.rects.len()).max(1) as f64;
+        (self.cost(st) / dof).max(f64::MIN_POSITIVE)
+    }
+
     /// The plain residual sum of squares, the coefficients' noise left in.
     pub(super) fn raw_cost(&self, st: &State) -> f64 {
         self.residual_squares(st, false)

@@ -464,8 +464,7 @@ pub fn fit_joint_with(
         uncertainty = finish(&problem, &mut st, &extents, spread.as_deref());
     }
     let cost = problem.cost(&st);
-    let dof = (problem.n() * 3).saturating_sub(7 * st.rects.len()).max(1) as f64;
-    let variance = (cost / dof).max(f64::MIN_POSITIVE);
+    let variance = problem.residual_variance(&st);
     optimise_seconds += t2.elapsed().as_secs_f64();
     // The water pixels alone: the direct view's sharp image of a light would match the photo
     // whatever the water model.

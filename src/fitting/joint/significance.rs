@@ -9,12 +9,22 @@
 //!   its modelled pixel, `m` all lights'). A light alone in its streak has share 1, however
 //!   faint; two lights that share a streak evenly about one half each.
 //! - its **significance**: its largest radiance channel in units of that channel's sigma.
+//! - its **image's significance**: its whole modelled image (every fitted pixel, each channel)
+//!   in units of the photo's noise, `sqrt(sum_p sum_c (m_k(p, c))^2 / s2)` with `s2` the
+//!   fit's residual variance per pixel and channel: how far the photo without the light
+//!   would lie from the photo with it.
 //!
 //! A light is dropped when its share is below [`MIN_SHARE`] (it explains almost nothing, as a
-//! light of zero radiance), or below [`WEAK_SHARE`] while no channel of its radiance is
-//! [`MIN_SIGNIFICANCE`] sigmas from zero (the photo would look the same without it). A real
-//! faint light beside a bright one is kept: its radiance is measured (the stacked samples'
-//! lower lights carry a third to a half of their streak, at tens of sigmas).
+//! light of zero radiance), when its image's significance is below [`MIN_IMAGE_SIGNIFICANCE`]
+//! (alone in its pixels, it lights them less than the photo's noise does), or when its share
+//! is below [`WEAK_SHARE`] while no channel of its radiance is [`MIN_SIGNIFICANCE`] sigmas
+//! from zero (the photo would look the same without it). A real faint light beside a bright
+//! one is kept: its radiance is measured (the stacked samples' lower lights carry a third to
+//! a half of their streak, at tens of sigmas). The radiance's significance alone cannot
+//! stand for the image's: out of frame a real light's height trades against its radiance,
+//! so its radiance's sigma can exceed its radiance while its reflection, the product, is
+//! measured at tens of sigmas (the harbour lights out of frame: 14-250; the lights left at a
+//! hundredth of their streak's radiance there: under 1).
 
 use super::problem::{Problem, State};
 use super::uncertainty::Uncertainty;
@@ -27,6 +37,24 @@ pub(super) const WEAK_SHARE: f64 = 0.25;
 
 /// Sigmas from zero a radiance channel needs to count as measured.
 pub(super) const MIN_SIGNIFICANCE: f64 = 2.0;
+
+/// The photo's noise sigmas a light's whole modelled image needs to count as seen.
+pub(super) const MIN_IMAGE_SIGNIFICANCE: f64 = 3.0;
+
+/// Per light, its modelled image's significance (module doc).
+pub(super) fn image_significance(problem: &Problem, st: &State) -> Vec<f64> {
+    let variance = problem.residual_variance(st);
+    (0..st.rects.len())
+        .map(|k| {
+            let l = st.radiance[k];
+            let energy: f64 = st.coef[k]
+                .iter()
+                .map(|&c| l.iter().map(|&l| (c as f64 * l).powi(2)).sum::<f64>())
+                .sum();
+            (energy / variance).sqrt()
+        })
+        .collect()
+}
 
 /// Per light, its share of the modelled light in the water pixels it lights (module doc); 0
 /// for a light that lights none.
@@ -81,6 +109,7 @@ pub(super) fn insignificant(
                 .fold(0.0, f64::max)
         })
         .collect();
+    let image = image_significance(problem, st);
     let mut drop: Vec<(usize, String)> = (0..st.rects.len())
         .filter_map(|k| {
             let (share, sig) = (shares[k], significance[k]);
@@ -91,6 +120,16 @@ pub(super) fn insignificant(
                         "it explained {:.1} % of the light where it lit the water (under {:.0} %)",
                         100.0 * share,
                         100.0 * MIN_SHARE
+                    ),
+                ))
+            } else if image[k] < MIN_IMAGE_SIGNIFICANCE {
+                Some((
+                    k,
+                    format!(
+                        "its whole modelled image came to {:.1} sigma of the photo's noise \
+                         (under {MIN_IMAGE_SIGNIFICANCE:.0}): the photo cannot tell it from \
+                         nothing",
+                        image[k]
                     ),
                 ))
             } else if share < WEAK_SHARE && sig < MIN_SIGNIFICANCE {
@@ -133,14 +172,32 @@ mod tests {
     use super::*;
     use crate::fitting::rect::Rect;
 
-    /// 20 water pixels; light k has coefficient `coef[k][i]` and radiance `radiance[k]`.
+    /// 20 water pixels; light k has coefficient `coef[k][i]` and radiance `radiance[k]`; the
+    /// photo is the lights' image with noise of 0.01 (see [`noisy_case`]).
     fn case(coef: Vec<Vec<f32>>, radiance: Vec<[f64; 3]>) -> (Problem, State) {
+        noisy_case(coef, radiance, 0.01)
+    }
+
+    /// [`case`] with the photo the lights' image plus or minus `noise` in every pixel and
+    /// channel, alternately: the residual's mean square is `noise^2`.
+    fn noisy_case(coef: Vec<Vec<f32>>, radiance: Vec<[f64; 3]>, noise: f64) -> (Problem, State) {
         let n = coef[0].len();
         let lights = coef.len();
+        let obs = (0..n)
+            .map(|i| {
+                std::array::from_fn(|c| {
+                    let m: f64 = (0..lights)
+                        .map(|k| coef[k][i] as f64 * radiance[k][c])
+                        .sum();
+                    let sign = if (i + c) % 2 == 0 { 1.0 } else { -1.0 };
+                    (m + sign * noise) as f32
+                })
+            })
+            .collect();
         let problem = Problem {
             width: n as u32,
             pixel_ids: (0..n as u32).collect(),
-            obs: vec![[0.0; 3]; n],
+            obs,
             clipped: vec![false; n],
             clipped_channels: vec![[false; 3]; n],
             planes: Vec::new(),
@@ -186,8 +243,29 @@ mod tests {
         let (p, st) = case(vec![lit(0, 10), lit(10, 10)], vec![[10.0; 3], [0.1; 3]]);
         let s = shares(&p, &st);
         assert_eq!(s, vec![1.0, 1.0]);
-        // Even unmeasured (its radiance within 1 sigma), it explains its own pixels: kept.
+        // Even unmeasured (its radiance within 1 sigma), it explains its own pixels, which it
+        // lights well above the photo's noise (0.01): kept.
         assert!(insignificant(&p, &st, &[sigma(0.1), sigma(0.2)]).is_empty());
+    }
+
+    #[test]
+    fn a_light_alone_under_the_noise_is_dropped() {
+        // The faint light's image: 0.1 in 3 channels of 10 pixels, sqrt(0.3) = 0.55 in all.
+        // Over noise of 0.05 it stands at 11 sigma; over noise of 0.5, at 1.1: the photo
+        // shows nothing there. The residual variance is the noise's over the 60 values less
+        // the 14 parameters: 60/46 of its square.
+        let lights = || (vec![lit(0, 10), lit(10, 10)], vec![[10.0; 3], [0.1; 3]]);
+        let (c, r) = lights();
+        let (p, st) = noisy_case(c, r, 0.05);
+        let z = image_significance(&p, &st);
+        let want = 0.3f64.sqrt() / (0.05 * (60.0f64 / 46.0).sqrt());
+        assert!((z[1] - want).abs() < 1e-3 * want, "{z:?} against {want}");
+        assert!(insignificant(&p, &st, &[sigma(0.1), sigma(0.2)]).is_empty());
+        let (c, r) = lights();
+        let (p, st) = noisy_case(c, r, 0.5);
+        let drop = insignificant(&p, &st, &[sigma(0.1), sigma(0.2)]);
+        assert_eq!(drop.iter().map(|d| d.0).collect::<Vec<_>>(), vec![1]);
+        assert!(drop[0].1.contains("1.0 sigma"), "{}", drop[0].1);
     }
 
     #[test]
