@@ -23,8 +23,8 @@
 //! a half of their streak, at tens of sigmas). The radiance's significance alone cannot
 //! stand for the image's: out of frame a real light's height trades against its radiance,
 //! so its radiance's sigma can exceed its radiance while its reflection, the product, is
-//! measured at tens of sigmas (the harbour lights out of frame: 14-250; the lights left at a
-//! hundredth of their streak's radiance there: under 1).
+//! measured at tens of sigmas (the harbour lights out of frame: 34-250; the lights left at a
+//! hundredth of their streak's radiance there: 1.2-2.7).
 
 use super::problem::{Problem, State};
 use super::uncertainty::Uncertainty;
