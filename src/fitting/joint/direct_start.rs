@@ -13,7 +13,9 @@
 //!   that light (its streaks join the other's): one lamp, one light.
 //!
 //! A start that already overlaps its direct image well is left alone, so that two lights
-//! whose direct images touch (stacked lamps) keep the starts the reflections gave them.
+//! whose direct images touch (stacked lamps) keep the starts the reflections gave them. A
+//! start with no direct image near it is cut back to the wall the photo does not show dark
+//! ([`super::dark_wall`]).
 //!
 //! The direct image near a light: the pixels outside the water whose camera ray (through the
 //! pixel's centre) meets the light's plane first, within the start rectangle grown by its own
@@ -21,6 +23,7 @@
 //! the brightest such pixel's largest channel); of their 8-connected groups in the image,
 //! the one whose centre on the plane is nearest the start's centre.
 
+use super::dark_wall::trimmed_to_unseen_wall;
 use super::direct_images::{images_in, DirectImage};
 use crate::fitting::rect::Rect;
 use crate::fitting::FittedLight;
@@ -47,10 +50,12 @@ pub(crate) fn direct_starts(
             .as_ref()
             .filter(|im| overlap(&light.rect(), &im.rect) < REPLACE_OVERLAP);
         let Some(im) = moved else {
+            let no_image = image.is_none();
             let kept = image.filter(|im| overlap(&light.rect(), &im.rect) >= REPLACE_OVERLAP);
             on_image.push(kept.as_ref().map(|im| im.first_pixel));
             out.push(match kept {
                 Some(im) if im.enclosed => trimmed(light, &im.reach),
+                None if no_image => trimmed_to_unseen_wall(scene, photo, water, light),
                 _ => light.clone(),
             });
             continue;
@@ -164,13 +169,13 @@ fn direct_image(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::fitting::light_plane::LightPlane;
 
     /// Table 1's scene and photo (one 3 m x 3 m light on the wall, in frame), the wall as a
     /// light plane, and the light's true rectangle on it (from the sample's definition).
-    fn table1() -> (Scene, Photo, Vec<bool>, LightPlane, Rect) {
+    pub(in crate::fitting::joint) fn table1() -> (Scene, Photo, Vec<bool>, LightPlane, Rect) {
         let (scene, photo, water, plane) = crate::fitting::joint::direct::tests::table1_wall();
         let truth = crate::samples::table1_light();
         let at = |x: f64, y: f64| {

@@ -100,6 +100,7 @@ mod boundary;
 mod colour;
 mod control_variate;
 mod cost;
+mod dark_wall;
 mod descent;
 mod direct;
 mod direct_images;
