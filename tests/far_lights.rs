@@ -154,6 +154,31 @@ fn far_small_lights_from_the_reflections_alone_within_their_sigmas() {
     );
 }
 
+/// `fit` at the defaults of the out-of-frame photo of harbour layout `layout` against sample
+/// scene `scene`: its report, with the water model it used held to `model` and one light per
+/// truth light, and the layout's truth lights.
+fn harbour_fit(scene: &str, layout: &str, model: &str) -> (Report, Vec<SampleLight>) {
+    let dir = sample_scenes();
+    let report = convert(&ConvertOptions {
+        exposure: samples::PHOTO_EXPOSURE,
+        ..ConvertOptions::new(
+            dir.join(scene),
+            sample_photo_path(&format!("harbour-{layout}-above.png")),
+            dir.join(format!("harbour-{layout}-above-fit-{model}.gltf")),
+        )
+    })
+    .expect("fit")
+    .report;
+    assert_eq!(report.water_model.model, model, "{:?}", report.water_model);
+    let truths = harbour::layouts()
+        .into_iter()
+        .find(|l| l.0 == layout)
+        .expect("the layout")
+        .2;
+    assert_eq!(report.lights.len(), truths.len(), "{:?}", report.warnings);
+    (report, truths)
+}
+
 /// The harbour pair out of frame over the photo's own waves (`harbour-pair-above.png` on
 /// `harbour-above.gltf`: the camera 2 m above the water, the lights 40 m away on the facade
 /// above the photo's top): at that distance the lobe's spread on the wall is larger than the
@@ -164,26 +189,8 @@ fn far_small_lights_from_the_reflections_alone_within_their_sigmas() {
 /// light's radiance 11.4 % low at 0.7 sigma).
 #[test]
 fn the_harbour_pair_out_of_frame_within_its_sigmas() {
-    let dir = sample_scenes();
-    let report = convert(&ConvertOptions {
-        exposure: samples::PHOTO_EXPOSURE,
-        ..ConvertOptions::new(
-            dir.join("harbour-above.gltf"),
-            sample_photo_path("harbour-pair-above.png"),
-            dir.join("harbour-pair-above-fit.gltf"),
-        )
-    })
-    .expect("fit")
-    .report;
-    assert_eq!(
-        report.water_model.model, "exact",
-        "{:?}",
-        report.water_model
-    );
-    assert_eq!(report.lights.len(), 2, "{:?}", report.warnings);
-    let layouts = harbour::layouts();
-    let truths = &layouts.iter().find(|l| l.0 == "pair").expect("the pair").2;
-    for truth in truths {
+    let (report, truths) = harbour_fit("harbour-above.gltf", "pair", "exact");
+    for truth in &truths {
         let light = nearest(&report.lights, truth);
         assert!(
             light.direct_pixels.is_none_or(|n| n == 0),
@@ -213,27 +220,9 @@ fn the_harbour_pair_out_of_frame_within_its_sigmas() {
 /// came out 29 m tall at a seven-hundredth of its radiance, 42 sigmas off.
 #[test]
 fn the_three_lights_out_of_frame_over_a_flat_quad_within_their_sigmas() {
-    let dir = sample_scenes();
-    let report = convert(&ConvertOptions {
-        exposure: samples::PHOTO_EXPOSURE,
-        ..ConvertOptions::new(
-            dir.join("harbour-above-flat.gltf"),
-            sample_photo_path("harbour-three-above.png"),
-            dir.join("harbour-three-above-flat-fit.gltf"),
-        )
-    })
-    .expect("fit")
-    .report;
-    assert_eq!(
-        report.water_model.model, "statistical",
-        "{:?}",
-        report.water_model
-    );
-    assert_eq!(report.lights.len(), 3, "{:?}", report.warnings);
-    let layouts = harbour::layouts();
-    let truths = &layouts.iter().find(|l| l.0 == "three").expect("three").2;
+    let (report, truths) = harbour_fit("harbour-above-flat.gltf", "three", "statistical");
     let mut matched = Vec::new();
-    for truth in truths {
+    for truth in &truths {
         let light = nearest(&report.lights, truth);
         assert!(!matched.contains(&light.name), "{} twice", light.name);
         matched.push(light.name.clone());
