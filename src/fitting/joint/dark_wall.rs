@@ -14,8 +14,11 @@
 //! seen dark when its point projects into the photo onto a pixel outside the water, the camera
 //! ray to it meets nothing before the light's plane, and that pixel's brightest channel is
 //! under [`DARK_SHARE`] of the start's brightest radiance channel (unclipped). Whole rows (or
-//! columns) of cells seen dark are peeled off each side while any are; a start seen dark
-//! everywhere is left as it is (the fit decides).
+//! columns) of cells seen dark are peeled off each side whose edge the estimate guessed (an
+//! edge placed from streak-edge pixels stands) while any are. A start seen dark over more than
+//! [`MOSTLY_DARK`] of its cells is left as it is: it is a stray fragment's more likely than a
+//! light's, and there the fit takes its radiance to zero and drops it, where cut back to the
+//! photo's edge it could survive as a strip along it.
 
 use crate::fitting::{EdgeSide, EdgeStatus, FittedLight};
 use crate::photo_in::Photo;
