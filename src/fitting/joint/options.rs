@@ -108,3 +108,38 @@ pub const DEFAULT_JOINT_SAMPLES: u32 = 72;
 /// The most lobe samples per pixel the joint fit takes: a pixel's stored samples are indexed
 /// in 16 bits (`samples::PlaneSamples::by_v`), and `effective_samples` of this is 32768.
 pub const MAX_JOINT_SAMPLES: u32 = 32_768;
+
+#[cfg(test)]
+mod tests {
+    use super::PixelShare;
+
+    /// Over a 100 x 100 block the shares read 10000, 5000 and 2500 pixels, each share's
+    /// pixels among the denser one's, and in every 2 x 2 block the quarter reads one.
+    #[test]
+    fn each_share_reads_its_part_of_the_pixels() {
+        let read = |share: PixelShare| {
+            (0..100u32)
+                .flat_map(|y| (0..100u32).map(move |x| (x, y)))
+                .filter(|&(x, y)| share.reads(x, y))
+                .collect::<Vec<_>>()
+        };
+        let (all, half, quarter) = (
+            read(PixelShare::All),
+            read(PixelShare::Checkerboard),
+            read(PixelShare::Quarter),
+        );
+        assert_eq!((all.len(), half.len(), quarter.len()), (10000, 5000, 2500));
+        assert!(quarter
+            .iter()
+            .all(|&(x, y)| PixelShare::Checkerboard.reads(x, y)));
+        for by in 0..50u32 {
+            for bx in 0..50u32 {
+                let inside = quarter
+                    .iter()
+                    .filter(|&&(x, y)| x / 2 == bx && y / 2 == by)
+                    .count();
+                assert_eq!(inside, 1, "block ({bx}, {by})");
+            }
+        }
+    }
+}
