@@ -304,6 +304,21 @@ impl Problem {
             .count()
     }
 
+    /// Whether a direct pixel sees a light of set `set`, rectangle `rect` and radiance
+    /// `radiance` whole (every sample inside the rectangle) in a channel the photo did not
+    /// clip and the light lights: its radiance is then read off its image, where otherwise
+    /// only the reflections give it (a light out of frame or hidden, or one whose image clips
+    /// in every channel).
+    pub(super) fn sees_radiance(&self, set: usize, rect: &Rect, radiance: [f64; 3]) -> bool {
+        let samples = &self.planes[set];
+        (self.first_direct..self.n()).any(|i| {
+            let points = &samples.points[samples.range(i)];
+            !points.is_empty()
+                && points.iter().all(|p| rect.contains(*p))
+                && (0..3).any(|c| radiance[c] > 0.0 && !self.clipped_channels[i][c])
+        })
+    }
+
     /// Per edge of `rect` (left, right, bottom, top), the direct pixels with a sample of set
     /// `set` whose kernel straddles that edge within the rectangle's span along it: the
     /// pixels that see the edge itself, and pin it to a fraction of a pixel.

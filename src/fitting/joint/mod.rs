@@ -480,6 +480,7 @@ pub fn fit_joint_with(
     let facing = facing_edges(&problem, &st);
     for (k, u) in uncertainty.iter_mut().enumerate() {
         u.direct_pixels = problem.direct_pixels_inside(st.set_of[k], &st.rects[k]);
+        u.radiance_seen = problem.sees_radiance(st.set_of[k], &st.rects[k], st.radiance[k]);
     }
     let lights = (0..st.rects.len())
         .map(|k| {

@@ -221,6 +221,7 @@ mod tests {
             edges: [Some(0.1); 4],
             radiance: [radiance; 3],
             direct_pixels: 0,
+            radiance_seen: false,
         }
     }
 

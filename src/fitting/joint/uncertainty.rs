@@ -20,6 +20,10 @@ pub struct Uncertainty {
     /// direct view off. The edges they cross pin the rectangle to a fraction of a pixel
     /// (their sigmas say how well).
     pub direct_pixels: usize,
+    /// Whether a fitted pixel sees the light whole in a channel the photo did not clip, so
+    /// that its radiance is read off its image ([`Problem::sees_radiance`]); otherwise the
+    /// reflections alone give it.
+    pub radiance_seen: bool,
 }
 
 /// One-sigma uncertainties of every light's free edges and radiances, from their full
@@ -186,6 +190,7 @@ pub(super) fn uncertainties(
             edges: [None; 4],
             radiance: [f32::INFINITY; 3],
             direct_pixels: 0,
+            radiance_seen: false,
         })
         .collect();
     if let Some(cov) = covariance {

@@ -34,7 +34,9 @@ mod uncertainty;
 
 use std::time::Instant;
 
-pub use uncertainty::{correlation_area, parameter_slopes, widen, MAX_LAG};
+pub use uncertainty::{
+    correlation_area, parameter_slopes, realisation_floor, widen, MAX_LAG, REALISATION_FLUX,
+};
 
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
@@ -323,6 +325,8 @@ pub fn estimate_slopes(
         [by_axis[0].as_ref(), by_axis[1].as_ref()],
         sigma_ln,
     );
+    let radiance: Vec<[f32; 3]> = lights.iter().map(|l| l.radiance).collect();
+    realisation_floor(&mut uncertainty, &radiance);
     Ok(SlopeEstimate {
         water: at,
         variance,

@@ -71,6 +71,31 @@ pub fn correlation_area(photo: &[[f32; 3]], width: u32, modelled: &[(u32, [f32; 
     area.max(1.0)
 }
 
+/// The relative uncertainty, at least, of a radiance the reflections alone give under the
+/// statistical model: how far one realisation of the waves moves the light a streak holds
+/// from the model's expectation over all of them. Measured on the samples' renders, the
+/// photo's flux over the water against the expectation at the waves' own slope variances
+/// (`tests/water_model.rs`): the harbour sign 5.4 % below, the pair 0-3.3 % per channel,
+/// the three lights 2-7 %, Table 1's light 0.5-1 m from a camera 0.2 m above the water 9 %
+/// (against the flat water of its gloss, whose slopes move it by 0.3 %): 5 % root mean
+/// square. No residual shows it: the fit explains the whole streak's light by the radiance
+/// (docs/decisions.md).
+pub const REALISATION_FLUX: f32 = 0.05;
+
+/// Every radiance sigma of a light whose radiance the reflections alone give (not
+/// [`Uncertainty::radiance_seen`]) raised to at least [`REALISATION_FLUX`] of that radiance
+/// (`radiance`: per light, in the order of `uncertainty`).
+pub fn realisation_floor(uncertainty: &mut [Uncertainty], radiance: &[[f32; 3]]) {
+    for (u, light) in uncertainty.iter_mut().zip(radiance) {
+        if u.radiance_seen {
+            continue;
+        }
+        for (sd, l) in u.radiance.iter_mut().zip(light) {
+            *sd = sd.max(REALISATION_FLUX * l.abs());
+        }
+    }
+}
+
 /// The least-squares slope of each light's parameters (left, right, bottom, top edges, then
 /// the three radiances) against `x`, over `points` (x and the lights fitted there, all with
 /// the same lights in the same order); `None` with fewer than two distinct x.
@@ -201,11 +226,30 @@ mod tests {
             edges: [Some(0.03), None, Some(0.01), Some(0.01)],
             radiance: [0.1; 3],
             direct_pixels: 0,
+            radiance_seen: false,
         }];
         widen(&mut u, 4.0, [Some(&s), None], [Some(0.1), None]);
         // Left: (0.03 * 2)^2 + (0.5 * 0.1)^2; radiance: (0.1 * 2)^2 + (2 * 0.1)^2.
         assert!((u[0].edges[EdgeSide::Left].unwrap() - 0.0781).abs() < 1e-3);
         assert_eq!(u[0].edges[EdgeSide::Right], None);
         assert!((u[0].radiance[0] - 0.2828).abs() < 1e-3);
+    }
+
+    #[test]
+    fn radiances_the_reflections_alone_give_get_the_realisations_floor() {
+        let lights = [[20.0, 10.0, 0.0]; 2];
+        let sigma = |seen: bool| Uncertainty {
+            edges: [Some(0.01); 4],
+            radiance: [0.3, 0.8, 0.0],
+            direct_pixels: 0,
+            radiance_seen: seen,
+        };
+        let mut u = vec![sigma(false), sigma(true)];
+        realisation_floor(&mut u, &lights);
+        // Unseen: 5 % of 20 is 1.0 (above 0.3); 5 % of 10 is 0.5 (below 0.8, kept).
+        assert_eq!(u[0].radiance, [1.0, 0.8, 0.0]);
+        assert_eq!(u[0].edges, [Some(0.01); 4]);
+        // Seen: left as it was.
+        assert_eq!(u[1].radiance, [0.3, 0.8, 0.0]);
     }
 }
