@@ -80,18 +80,26 @@ pub fn correlation_area(photo: &[[f32; 3]], width: u32, modelled: &[(u32, [f32; 
 /// (against the flat water of its gloss, whose slopes move it by 0.3 %): 5 % root mean
 /// square. No residual shows it: the fit explains the whole streak's light by the radiance
 /// (docs/decisions.md).
-pub const REALISATION_FLUX: f32 = 0.05;
+pub const REALISATION_FLUX: f64 = 0.05;
 
 /// Every radiance sigma of a light whose radiance the reflections alone give (not
 /// [`Uncertainty::radiance_seen`]) raised to at least [`REALISATION_FLUX`] of that radiance
-/// (`radiance`: per light, in the order of `uncertainty`).
+/// (`radiance`: per light, in the order of `uncertainty`). The floor is rounded down to an
+/// `f32`, so that it never reaches above the report's large uncertainty
+/// ([`crate::report::LARGE_UNCERTAINTY`], the same 5 %) by rounding: a light is warned about
+/// only when the fit's own sigma is larger.
 pub fn realisation_floor(uncertainty: &mut [Uncertainty], radiance: &[[f32; 3]]) {
     for (u, light) in uncertainty.iter_mut().zip(radiance) {
         if u.radiance_seen {
             continue;
         }
         for (sd, l) in u.radiance.iter_mut().zip(light) {
-            *sd = sd.max(REALISATION_FLUX * l.abs());
+            let exact = REALISATION_FLUX * l.abs() as f64;
+            let mut floor = exact as f32;
+            if floor as f64 > exact {
+                floor = floor.next_down();
+            }
+            *sd = sd.max(floor);
         }
     }
 }
@@ -247,7 +255,18 @@ mod tests {
         let mut u = vec![sigma(false), sigma(true)];
         realisation_floor(&mut u, &lights);
         // Unseen: 5 % of 20 is 1.0 (above 0.3); 5 % of 10 is 0.5 (below 0.8, kept).
-        assert_eq!(u[0].radiance, [1.0, 0.8, 0.0]);
+        assert!((u[0].radiance[0] - 1.0).abs() < 1e-6, "{:?}", u[0].radiance);
+        assert_eq!(u[0].radiance[1..], [0.8, 0.0]);
+        // Never above 5 % by rounding, over many radiances.
+        for i in 1..2000 {
+            let l = 0.37 * i as f32;
+            let mut v = vec![sigma(false)];
+            v[0].radiance = [0.0; 3];
+            realisation_floor(&mut v, &[[l; 3]]);
+            let sd = v[0].radiance[0] as f64;
+            assert!(sd <= REALISATION_FLUX * l as f64, "{l}: {sd}");
+            assert!(sd > 0.999_999 * REALISATION_FLUX * l as f64, "{l}: {sd}");
+        }
         assert_eq!(u[0].edges, [Some(0.01); 4]);
         // Seen: left as it was.
         assert_eq!(u[1].radiance, [0.3, 0.8, 0.0]);
