@@ -95,6 +95,11 @@ fn the_direct_view_pins_table1s_light() {
         "{counted} against {seen}"
     );
     assert_eq!(l_off.direct_pixels, Some(0));
+    // Its image clips in every channel: only the reflections give its radiance, either way.
+    assert_eq!(
+        (l_on.radiance_seen, l_off.radiance_seen),
+        (Some(false), Some(false))
+    );
     // Every edge is seen directly: constrained, by more pixels than the reflections alone.
     for (on, off) in [
         (&l_on.edges.left, &l_off.edges.left),

@@ -47,6 +47,8 @@ fn an_orange_lamp_under_a_blue_one_gives_two_lights() {
     for truth in &truths {
         let light = nearest(&report.lights, truth);
         assert_light_within("in the photo", light, truth, 0.02, OfChannel(0.03));
+        // Orange (24, 12, 3) and blue (4, 10, 24) at exposure 0.1 leave blue and red unclipped.
+        assert_eq!(light.radiance_seen, Some(true), "{}", truth.name);
     }
 }
 
@@ -137,6 +139,7 @@ fn orange_and_blue_lamps_out_of_frame_are_split_by_their_colours() {
             "{} is seen directly",
             truth.name
         );
+        assert_eq!(light.radiance_seen, Some(false), "{}", truth.name);
         assert_light_within("out of frame", light, truth, 0.02, OfChannel(0.03));
         assert_within_sigmas(light, truth, 3.0);
     }

@@ -180,6 +180,7 @@ pub fn light_report(
         },
         uncertainty: uncertainty.and_then(|u| uncertainty_report(light, u)),
         direct_pixels: uncertainty.map(|u| u.direct_pixels),
+        radiance_seen: uncertainty.map(|u| u.radiance_seen),
         light_index: None,
         node_index: None,
         node_translation: None,
