@@ -77,9 +77,11 @@ pub fn correlation_area(photo: &[[f32; 3]], width: u32, modelled: &[(u32, [f32; 
 /// photo's flux over the water against the expectation at the waves' own slope variances
 /// (`tests/water_model.rs`): the harbour sign 5.4 % below, the pair 0-3.3 % per channel,
 /// the three lights 2-7 %, Table 1's light 0.5-1 m from a camera 0.2 m above the water 9 %
-/// (against the flat water of its gloss, whose slopes move it by 0.3 %): 5 % root mean
-/// square. No residual shows it: the fit explains the whole streak's light by the radiance
-/// (docs/decisions.md).
+/// (against the flat water of its gloss, whose slopes move it by 0.3 %); the same lights
+/// over the other realisation of the waves (the `other-waves` scenes) 0.3-5.8 % above or
+/// 2.5-4.4 % below at the harbour, and 4.3 % below close to the water. 4.3 % root mean square
+/// over the 23 (close to the water alone, 7 %), rounded up. No residual shows it: the fit
+/// explains the whole streak's light by the radiance (docs/decisions.md).
 pub const REALISATION_FLUX: f64 = 0.05;
 
 /// Every radiance sigma of a light whose radiance the reflections alone give (not
