@@ -48,6 +48,36 @@ fn flattened(mut scene: Scene) -> Scene {
     scene
 }
 
+/// The statistical water over `scene`'s mean plane with the harbour waves' own slope
+/// variances (the spectrum the harbour samples' meshes are drawn from), for a `w` x `h`
+/// image.
+fn harbour_expectation(
+    scene: &Scene,
+    w: u32,
+    h: u32,
+) -> streaklight::water_model::StatisticalSurface {
+    let spectrum = streaklight::samples::harbour_waves::harbour_spectrum();
+    streaklight::water_model::StatisticalSurface {
+        surface: water_statistics(scene, w, h).unwrap().surface,
+        waves: [
+            spectrum.rms_slope_along.powi(2) as f32,
+            spectrum.rms_slope_across.powi(2) as f32,
+        ],
+    }
+}
+
+/// Per pixel of a `w` x `h` image, whether the camera ray through its centre meets the
+/// water first.
+fn water_pixels(scene: &Scene, w: u32, h: u32) -> Vec<bool> {
+    use streaklight::render::{camera_hit, CameraHit};
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+            matches!(camera_hit(scene, &[], x, y, w, h), CameraHit::Water(_))
+        })
+        .collect()
+}
+
 /// Table 1's photo was rendered from the scene's own water mesh: the fit keeps the exact model,
 /// having measured that the fine structures match (0.86 when this was written; a photo of
 /// other waves gives about 0).
@@ -193,20 +223,11 @@ fn a_small_flat_scene_at_the_defaults() {
 #[test]
 fn the_expected_image_holds_the_photos_flux_and_centroids() {
     use streaklight::render::{camera_hit, render, CameraHit, RenderOptions};
-    use streaklight::samples::harbour_waves::harbour_spectrum;
-    use streaklight::water_model::StatisticalSurface;
 
     let scene = sample_scene("harbour-pair-above-truth.gltf", None);
     let photo = sample_photo("harbour-pair-above.png");
     let (w, h) = (photo.width, photo.height);
-    let spectrum = harbour_spectrum();
-    let water = StatisticalSurface {
-        surface: water_statistics(&scene, w, h).unwrap().surface,
-        waves: [
-            spectrum.rms_slope_along.powi(2) as f32,
-            spectrum.rms_slope_across.powi(2) as f32,
-        ],
-    };
+    let water = harbour_expectation(&scene, w, h);
     let model = render(
         &scene,
         &RenderOptions {
@@ -373,7 +394,7 @@ fn reflected_rays_above_the_crests_meet_what_the_whole_scene_shows_them() {
 /// the waves' slopes move the model's flux by under half a percent.
 #[test]
 fn close_to_the_water_the_photos_waves_hold_less_light_than_their_expectation() {
-    use streaklight::render::{camera_hit, render_with_lights, CameraHit, RenderOptions};
+    use streaklight::render::{render_with_lights, RenderOptions};
     use streaklight::water_model::{StatisticalSurface, WaterModel};
 
     let truth = sample_scene("table1-truth.gltf", None);
@@ -406,12 +427,7 @@ fn close_to_the_water_the_photos_waves_hold_less_light_than_their_expectation() 
         .unwrap()
         .pixels;
     // Flux per band of 20 rows over the water.
-    let on_water: Vec<bool> = (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            matches!(camera_hit(&flat, &[], x, y, w, h), CameraHit::Water(_))
-        })
-        .collect();
+    let on_water = water_pixels(&flat, w, h);
     let bands = |img: &[[f32; 3]]| {
         let mut out = vec![0f64; (h as usize).div_ceil(20)];
         for (i, p) in img.iter().enumerate() {
@@ -477,19 +493,12 @@ fn close_to_the_water_the_photos_waves_hold_less_light_than_their_expectation() 
 /// trusted: the fit gives it 3.9 % low (README).
 #[test]
 fn the_signs_photo_holds_less_light_than_its_expectation() {
-    use streaklight::render::{camera_hit, render_with_lights, CameraHit, RenderOptions};
-    use streaklight::samples::harbour_waves::harbour_spectrum;
-    use streaklight::water_model::StatisticalSurface;
+    use streaklight::render::{render_with_lights, RenderOptions};
 
     let scene = sample_scene("harbour-sign-truth.gltf", None);
     let photo = sample_photo("harbour-sign.png");
     let (w, h) = (photo.width, photo.height);
-    let on_water: Vec<bool> = (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            matches!(camera_hit(&scene, &[], x, y, w, h), CameraHit::Water(_))
-        })
-        .collect();
+    let on_water = water_pixels(&scene, w, h);
     let flux = |img: &[[f32; 3]]| -> f64 {
         img.iter()
             .zip(&on_water)
@@ -497,14 +506,7 @@ fn the_signs_photo_holds_less_light_than_its_expectation() {
             .map(|(p, _)| (p[0] + p[1] + p[2]) as f64)
             .sum()
     };
-    let spectrum = harbour_spectrum();
-    let water = StatisticalSurface {
-        surface: water_statistics(&scene, w, h).unwrap().surface,
-        waves: [
-            spectrum.rms_slope_along.powi(2) as f32,
-            spectrum.rms_slope_across.powi(2) as f32,
-        ],
-    };
+    let water = harbour_expectation(&scene, w, h);
     let options = RenderOptions {
         width: w,
         height: h,
