@@ -235,8 +235,11 @@ impl Run<'_> {
                      step a joint fit)",
                     self.observations.len()
                 ));
+                // Out of frame the reflections alone cannot tell stacked lights of one colour
+                // from one (joint fit's `stacked_as_one`).
                 let final_fit = JointOptions {
                     model,
+                    stacked_as_one: true,
                     ..self.joint_options(j, j.reading)
                 };
                 let est = estimate_slopes(

@@ -121,6 +121,7 @@ mod repeats;
 mod samples;
 mod significance;
 mod split;
+mod stacked;
 mod uncertainty;
 
 pub use options::{JointOptions, PixelShare, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
@@ -432,7 +433,12 @@ pub fn fit_joint_with(
     let mut uncertainty = finish(&problem, &mut st, &extents, spread.as_deref());
     // Lights the photo cannot tell from nothing are dropped, the others fitted again
     // without them (`significance`).
-    let dropped = significance::insignificant(&problem, &st, &uncertainty);
+    let mut dropped = significance::insignificant(&problem, &st, &uncertainty);
+    if options.stacked_as_one {
+        let skip: Vec<usize> = dropped.iter().map(|d| d.0).collect();
+        dropped.extend(stacked::stacked(&problem, &st, start, &skip));
+        dropped.sort_by_key(|d| d.0);
+    }
     let mut warnings = Vec::new();
     if !dropped.is_empty() {
         for (k, why) in dropped.iter().rev() {

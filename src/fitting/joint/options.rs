@@ -53,6 +53,10 @@ pub struct JointOptions<'a> {
     /// where a light is in the photo, its direct image pins its edges to a fraction of a
     /// pixel. Off, only the water pixels are read.
     pub direct_view: bool,
+    /// Take lights stacked in one column of one face, of one colour, for one light and drop
+    /// the weaker (`stacked`): under a statistical water model the reflections alone cannot
+    /// tell them apart. Off by default (the exact model tells stacked lamps apart).
+    pub stacked_as_one: bool,
 }
 
 impl JointOptions<'_> {
@@ -73,6 +77,7 @@ impl JointOptions<'_> {
             progress: Reporter::default(),
             control_variate: true,
             direct_view: true,
+            stacked_as_one: false,
         }
     }
 }

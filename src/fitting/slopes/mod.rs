@@ -180,6 +180,7 @@ pub fn estimate_slopes(
         split: false,
         region_water: Some(&broad),
         progress: final_fit.progress,
+        stacked_as_one: final_fit.stacked_as_one,
         ..JointOptions::new(model, paper.seed)
     };
     // Each axis's last pass: (ln variance, the lights fitted there).
