@@ -431,8 +431,9 @@ pub fn fit_joint_with(
     };
     let mut spread = spread;
     let mut uncertainty = finish(&problem, &mut st, &extents, spread.as_deref());
-    // Lights the photo cannot tell from nothing are dropped, the others fitted again
-    // without them (`significance`).
+    // Lights the photo cannot tell from nothing (`significance`), or, where asked, from a
+    // light of their colour in their column (`stacked`), are dropped, the others fitted
+    // again without them.
     let mut dropped = significance::insignificant(&problem, &st, &uncertainty);
     if options.stacked_as_one {
         let skip: Vec<usize> = dropped.iter().map(|d| d.0).collect();
@@ -462,7 +463,7 @@ pub fn fit_joint_with(
         warnings.reverse();
         options.progress.stage(&format!(
             "joint fit: descent of {} light(s) after dropping {} the photo cannot tell from \
-             nothing",
+             nothing or from another light",
             st.rects.len(),
             dropped.len()
         ));
