@@ -236,10 +236,12 @@ impl Run<'_> {
                     self.observations.len()
                 ));
                 // Out of frame the reflections alone cannot tell stacked lights of one colour
-                // from one (joint fit's `stacked_as_one`).
+                // from one (joint fit's `stacked_as_one`), and the residual is the glitter,
+                // whose noise weights the final fit (`glitter_weights`).
                 let final_fit = JointOptions {
                     model,
                     stacked_as_one: true,
+                    glitter_weights: true,
                     ..self.joint_options(j, j.reading)
                 };
                 let est = estimate_slopes(

@@ -107,6 +107,7 @@ mod direct_images;
 pub(crate) mod direct_start;
 #[cfg(test)]
 mod fixture;
+mod glitter;
 mod kernel;
 mod lamp_starts;
 mod near;
@@ -430,6 +431,24 @@ pub fn fit_joint_with(
         (State { radiance, ..st }, Some(spread))
     };
     let mut spread = spread;
+    // Weighted by the glitter's noise where asked (`glitter`): the first fit's residual
+    // gives the noise model, and the fit is descended again over the weighted rows.
+    let mut scales: Option<Vec<f32>> = None;
+    if options.glitter_weights && repeats.len() == 1 {
+        let areas = glitter::footprint_areas(water_model, scene, &problem, photo.height);
+        if let Some((_, s)) = glitter::glitter_scales(&problem, &st, &areas) {
+            glitter::scale_rows(&mut problem, &s);
+            st = problem.state(
+                st.set_of.clone(),
+                st.pinned.clone(),
+                st.rects.clone(),
+                st.radiance.clone(),
+            );
+            problem.solve_radiance(&mut st);
+            problem.descend(&mut st, &extents, options.sweeps);
+            scales = Some(s);
+        }
+    }
     let mut uncertainty = finish(&problem, &mut st, &extents, spread.as_deref());
     // Lights the photo cannot tell from nothing (`significance`), or, where asked, from a
     // light of their colour in their column (`stacked`), are dropped, the others fitted
@@ -478,9 +497,10 @@ pub fn fit_joint_with(
     // whatever the water model.
     let modelled = (0..problem.first_direct)
         .map(|i| {
+            let s = scales.as_ref().map_or(1.0, |s| s[i]);
             (
                 problem.pixel_ids[i],
-                problem.model(&st, i).map(|c| c as f32),
+                problem.model(&st, i).map(|c| c as f32 / s),
             )
         })
         .collect();

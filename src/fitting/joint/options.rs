@@ -57,6 +57,11 @@ pub struct JointOptions<'a> {
     /// the weaker (`stacked`): under a statistical water model the reflections alone cannot
     /// tell them apart. Off by default (the exact model tells stacked lamps apart).
     pub stacked_as_one: bool,
+    /// Weight the water pixels by the glitter's noise (`glitter`): a first fit's residual
+    /// gives each pixel's variance from its expectation and footprint, and the fit is
+    /// descended again by weighted least squares. Off by default (the exact model's residual
+    /// is not glitter).
+    pub glitter_weights: bool,
 }
 
 impl JointOptions<'_> {
@@ -78,6 +83,7 @@ impl JointOptions<'_> {
             control_variate: true,
             direct_view: true,
             stacked_as_one: false,
+            glitter_weights: false,
         }
     }
 }
