@@ -214,9 +214,9 @@ fn the_harbour_pair_out_of_frame_within_its_sigmas() {
 /// `harbour-above-flat.gltf`): from the reflections alone each light's height trades against
 /// the waves' slope along the view, which the photo cannot tell apart, so what is held is
 /// what the uncertainties say: the statistical model, three lights, one per truth, and every
-/// error the report gives a sigma for within 3 of it (measured: the tall light's right edge
-/// 31 % of its width in at 0.9 sigma the farthest; the warm light's radiance three times its
-/// own at 0.0 sigma: out of frame the radiance is not told from the height). The red light's start reaches down its wall to the
+/// error the report gives a sigma for within 3 of it (measured: the tall light's side edges
+/// 21-24 % of its width off at 0.7 sigma the farthest; the warm light's radiance 40 % low at
+/// 0.4 sigma: out of frame the radiance is not told from the height). The red light's start reaches down its wall to the
 /// foot the photo shows dark; cut back from there it comes out 6 % dim, where left there it
 /// came out 29 m tall at a seven-hundredth of its radiance, 42 sigmas off.
 #[test]
@@ -237,7 +237,7 @@ fn the_three_lights_out_of_frame_over_a_flat_quad_within_their_sigmas() {
 /// second light of the sign's colour 8 m above it on the facade (10.8 x 15.9 m) explained it;
 /// the reflections alone cannot tell two lights stacked in one column from one, so the
 /// weaker goes. Held: one light, every error within 3 of its sigmas (measured: the top edge
-/// 122 % of the sign's height high and its radiance 37 % low, both within 0.7 sigma), and
+/// 81 % of the sign's height high and its radiance 44 % low, every error within 0.9 sigma), and
 /// the report saying why the other light was dropped.
 #[test]
 fn the_sign_out_of_frame_over_a_flat_quad_is_one_light() {

@@ -16,6 +16,7 @@
 //! squares over scaled rows. Pixels that see a light directly keep a scale of 1.
 
 use super::problem::{Problem, State};
+use super::samples::PlaneSamples;
 use crate::scene_in::Scene;
 use crate::water_model::WaterModel;
 
@@ -124,13 +125,19 @@ pub(super) fn scale_rows(problem: &mut Problem, scales: &[f32]) {
         *o = o.map(|v| v * s);
     }
     for set in &mut problem.planes {
-        for (i, &s) in scales.iter().enumerate() {
-            let r = set.range(i);
-            for w in &mut set.weights[r] {
-                *w *= s;
-            }
-            set.gauss[i].mass *= s;
+        scale_set(set, scales);
+    }
+}
+
+/// Multiplies every coefficient of pixel i in one sample set by `scales[i]` (a set traced
+/// after the rows were scaled).
+pub(super) fn scale_set(set: &mut PlaneSamples, scales: &[f32]) {
+    for (i, &s) in scales.iter().enumerate() {
+        let r = set.range(i);
+        for w in &mut set.weights[r] {
+            *w *= s;
         }
+        set.gauss[i].mass *= s;
     }
 }
 

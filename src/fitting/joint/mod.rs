@@ -166,6 +166,8 @@ pub struct JointOutcome {
     /// The start lights the fit explained as two, and which way
     /// ([`JointOptions::known_splits`] of a refit).
     pub splits: Vec<Split>,
+    /// Per fitted pixel, the scale its row was weighted by (`glitter`), when it was.
+    pub row_scales: Option<Vec<f32>>,
 }
 
 impl JointOutcome {
@@ -242,6 +244,7 @@ pub fn fit_joint_with(
             modelled: Vec::new(),
             warnings: Vec::new(),
             splits: Vec::new(),
+            row_scales: None,
         });
     }
     // Starts far from the lights' direct images are moved onto them (`direct_start`).
@@ -350,6 +353,10 @@ pub fn fit_joint_with(
             first_direct,
         }
     };
+    // Rows weighted from the start by a fit before over the same pixels (`row_scales`).
+    let given_scales = options
+        .row_scales
+        .filter(|s| s.len() == pixels.len() && options.repeats == 1);
     // Seconds spent tracing the split lights' own sample sets (footprints, not optimisation).
     let fresh_seconds = std::cell::Cell::new(0.0);
     // The `draw`-th extra sample set of repeat `repeat`, on start light `origin`'s plane,
@@ -358,8 +365,12 @@ pub fn fit_joint_with(
         let t = Instant::now();
         let (mut stored, _) = trace(&[planes[origin]], &[roi[origin]], repeat, draw);
         fresh_seconds.set(fresh_seconds.get() + t.elapsed().as_secs_f64());
-        // One plane in, one set out.
-        stored.swap_remove(0)
+        // One plane in, one set out, weighted as the others.
+        let mut set = stored.swap_remove(0);
+        if let Some(s) = given_scales {
+            glitter::scale_set(&mut set, s);
+        }
+        set
     };
     options.progress.stage(&format!(
         "joint fit: tracing the footprints of {} pixels, {} samples each",
@@ -367,6 +378,9 @@ pub fn fit_joint_with(
         effective_samples(options.samples)
     ));
     let mut problem = problem_for(0);
+    if let Some(s) = given_scales {
+        glitter::scale_rows(&mut problem, s);
+    }
     let mut footprint_seconds = t0.elapsed().as_secs_f64();
     options.progress.stage(&format!(
         "joint fit: descent of {} light(s), {} sweeps",
@@ -433,8 +447,8 @@ pub fn fit_joint_with(
     let mut spread = spread;
     // Weighted by the glitter's noise where asked (`glitter`): the first fit's residual
     // gives the noise model, and the fit is descended again over the weighted rows.
-    let mut scales: Option<Vec<f32>> = None;
-    if options.glitter_weights && repeats.len() == 1 {
+    let mut scales: Option<Vec<f32>> = given_scales.map(|s| s.to_vec());
+    if options.glitter_weights && scales.is_none() && repeats.len() == 1 {
         let areas = glitter::footprint_areas(water_model, scene, &problem, photo.height);
         if let Some((_, s)) = glitter::glitter_scales(&problem, &st, &areas) {
             glitter::scale_rows(&mut problem, &s);
@@ -560,6 +574,7 @@ pub fn fit_joint_with(
         modelled,
         warnings,
         splits,
+        row_scales: scales,
     })
 }
 

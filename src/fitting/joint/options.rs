@@ -62,6 +62,11 @@ pub struct JointOptions<'a> {
     /// descended again by weighted least squares. Off by default (the exact model's residual
     /// is not glitter).
     pub glitter_weights: bool,
+    /// Per fitted pixel, the scale of its row as a fit before over the same pixels measured
+    /// it ([`super::JointOutcome::row_scales`]): the fit is weighted by it from the start,
+    /// so that fits under different lobes compare their costs under one set of weights.
+    /// Ignored when its length is not the fit's pixel count or with several repeats.
+    pub row_scales: Option<&'a [f32]>,
 }
 
 impl JointOptions<'_> {
@@ -84,6 +89,7 @@ impl JointOptions<'_> {
             direct_view: true,
             stacked_as_one: false,
             glitter_weights: false,
+            row_scales: None,
         }
     }
 }

@@ -19,7 +19,9 @@
 //! full search took on Table 1's photo over a flat quad, the estimates within 0.3 %.
 //! Every fit starts from the same lights (the paper fit at the starting variances), reads the
 //! same pixels (those the broadest lobe of the search can see: four times the starting
-//! variances) with the same random numbers, so the costs are comparable.
+//! variances) with the same random numbers, so the costs are comparable. When the final fit
+//! is weighted by the glitter's noise (`JointOptions::glitter_weights`), so is every fit of
+//! the search, all by the weights the first one measured, so that their costs still compare.
 //!
 //! The variances are the lobe's whole: the water's microfacets are given a gloss of
 //! [`MICROFACET_GLOSS`], finer than any wave, and the waves' variances carry the rest. So the
@@ -194,12 +196,16 @@ pub fn estimate_slopes(
     let mut anchor = start_variance;
     let mut sigma_ln = [None, None];
     let t = Instant::now();
+    // The weights of the first fit's rows, which every later fit of the search takes.
+    let search_scales: std::cell::OnceCell<Vec<f32>> = std::cell::OnceCell::new();
     // The `number`-th fit, at variances `v`.
     let eval = |v: [f32; 2], number: usize| -> Result<(Point, Vec<FittedLight>)> {
         final_fit.progress.stage(&format!(
             "slope search: joint fit {number} at variances {:.2e} along, {:.2e} across",
             v[0], v[1]
         ));
+        // Weighted as the final fit is, every fit by the first one's weights (`row_scales`).
+        let weighted = final_fit.glitter_weights;
         let fit = fit_joint_with(
             &water_with_total(surface, v),
             scene,
@@ -207,8 +213,17 @@ pub fn estimate_slopes(
             water,
             streaks,
             &start,
-            &search_options,
+            &JointOptions {
+                glitter_weights: weighted,
+                row_scales: search_scales.get().map(|s| &s[..]),
+                ..search_options
+            },
         )?;
+        if weighted && search_scales.get().is_none() {
+            if let Some(s) = fit.row_scales.clone() {
+                let _ = search_scales.set(s);
+            }
+        }
         let s = if fit.cost.is_finite() && fit.cost > 0.0 {
             fit.cost
         } else {
