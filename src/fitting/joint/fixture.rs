@@ -139,3 +139,13 @@ pub(super) fn start_light(
         edges: [free(), free(), free(), free()],
     }
 }
+
+/// The rectangle from its four edges.
+pub(super) fn rect(u_min: f32, u_max: f32, v_min: f32, v_max: f32) -> Rect {
+    Rect {
+        u_min,
+        u_max,
+        v_min,
+        v_max,
+    }
+}

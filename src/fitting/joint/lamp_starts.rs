@@ -236,14 +236,7 @@ fn mirror_in_box(scene: &Scene, photo: &Photo, pixels: &[u32], lamp: Vec3, heigh
 mod tests {
     use super::*;
 
-    fn rect(u_min: f32, u_max: f32, v_min: f32, v_max: f32) -> Rect {
-        Rect {
-            u_min,
-            u_max,
-            v_min,
-            v_max,
-        }
-    }
+    use crate::fitting::joint::fixture::rect;
 
     fn image(r: Rect) -> DirectImage {
         DirectImage {

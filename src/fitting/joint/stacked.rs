@@ -147,14 +147,7 @@ mod tests {
         LightPlane::with_frame((node, 0, 0), origin, Vec3::Z, Vec3::X, 1.0).expect("a plane")
     }
 
-    fn rect(u_min: f32, u_max: f32, v_min: f32, v_max: f32) -> Rect {
-        Rect {
-            u_min,
-            u_max,
-            v_min,
-            v_max,
-        }
-    }
+    use crate::fitting::joint::fixture::rect;
 
     fn column<'a>(plane: &'a LightPlane, rect: Rect, radiance: [f64; 3], image: f64) -> Column<'a> {
         Column {
@@ -177,22 +170,17 @@ mod tests {
     #[test]
     fn a_fragments_light_above_a_light_of_its_colour_goes() {
         let plane = wall(0, Vec3::ZERO);
-        let sign = column(
-            &plane,
-            rect(-1.0, 5.1, -0.4, 3.1),
-            [5.12, 4.61, 3.59],
-            224.0,
-        );
-        let fragment = column(&plane, rect(-6.5, 4.4, 1.5, 17.4), [4.33, 3.90, 3.04], 43.9);
-        assert_eq!(dropped(&[sign, fragment]), vec![1]);
-        let sign = column(
-            &plane,
-            rect(-1.0, 5.1, -0.4, 3.1),
-            [5.12, 4.61, 3.59],
-            224.0,
-        );
-        let fragment = column(&plane, rect(-6.5, 4.4, 1.5, 17.4), [4.33, 3.90, 3.04], 43.9);
-        let got = weaker_of_stacked(&[fragment, sign], &[]);
+        let sign = || {
+            column(
+                &plane,
+                rect(-1.0, 5.1, -0.4, 3.1),
+                [5.12, 4.61, 3.59],
+                224.0,
+            )
+        };
+        let fragment = || column(&plane, rect(-6.5, 4.4, 1.5, 17.4), [4.33, 3.90, 3.04], 43.9);
+        assert_eq!(dropped(&[sign(), fragment()]), vec![1]);
+        let got = weaker_of_stacked(&[fragment(), sign()], &[]);
         assert_eq!(got.iter().map(|d| d.0).collect::<Vec<_>>(), vec![0]);
         assert!(got[0].1.contains("one column"), "{}", got[0].1);
     }
