@@ -111,7 +111,7 @@ fn other_waves_take_the_statistical_model() {
 /// the view and 2.0e-3 across (the harbour chop's over the water the lights' reflections
 /// lie on), rendered as linear floats; fitted at the defaults against the same quad, whose
 /// material starts the search isotropic at 3.1e-3 (e = 321). Both variances come out within
-/// 5 % (measured: 3.0 % and 3.5 % high, from an isotropic start off by 6 % and 55 %), and the
+/// 5 % (measured: 2.4 % and 1.7 % high, from an isotropic start off by 6 % and 55 %), and the
 /// lights within 3 %. Over real waves one photo's estimate scatters far more (method §10):
 /// the slopes of the few metres of water one streak reflects differ from the waves'.
 #[test]

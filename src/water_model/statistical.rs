@@ -48,6 +48,19 @@ impl StatisticalSurface {
     pub fn slopes(&self, gloss: f32) -> GaussianSlopes {
         GaussianSlopes::microfacets_and_waves(gloss, self.waves)
     }
+
+    /// `f(wo, wi) (n.wi)` of the lobe under `model` (its gloss and IOR; the waves' masking
+    /// always, as [`WaterModel::reflect`] draws it) at the mean surface: what a sample drawn
+    /// towards `wi` from another lobe weighs for this one, over the density it was drawn with.
+    pub fn eval_cos(&self, model: &ReflectionModel, wo: Vec3, wi: Vec3) -> f32 {
+        self.slopes(model.gloss).eval_cos(
+            &masked(model),
+            self.surface.normal,
+            self.surface.along,
+            wo,
+            wi,
+        )
+    }
 }
 
 /// `model` with the waves' masking (module doc).

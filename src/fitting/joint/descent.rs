@@ -120,7 +120,7 @@ impl Problem {
 
 /// Where an edge may go: inside the samples' extent (with `eps`, the smallest window, to
 /// spare) and no nearer the opposite edge than `min_size`
-/// ([`super::samples::smallest_light`]).
+/// ([`super::kernel::smallest_light`]).
 fn edge_bounds(r: &Rect, side: EdgeSide, ext: &Rect, min_size: Vec2, eps: f32) -> (f32, f32) {
     match side {
         EdgeSide::Left => (ext.u_min - eps, r.u_max - min_size.x),

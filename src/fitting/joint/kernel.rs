@@ -147,6 +147,37 @@ pub(super) fn kernel_coverage(x: f32, h: f32, lo: f32, hi: f32) -> f32 {
 /// every purpose, but with a slope the ramps can hold.
 pub(super) const POINT_CELL: f32 = 1e-6;
 
+/// The smallest width and height of a light whose samples' kernels have the half-widths
+/// `cells`: twice the median half-width along each axis, the kernels' typical full width (at
+/// least [`SMALLEST_LIGHT_SHARE`] of the plane's `distance` from the camera, when the cells
+/// are points). A narrower rectangle is seen only through the
+/// kernels' shape (its coefficient is the kernels' density where it lies, negative lobes
+/// included, from the few samples near it), so its coefficients are noise out of all
+/// proportion to their size, and the fit, which subtracts the estimated noise from its cost,
+/// rewards exactly that: two stacked lights 1.8 m apart came out as the lower light and a
+/// 1 mm sliver at 1400 times the radiance, at a cost 90 below the truth's (docs/decisions.md, "No light
+/// thinner than its samples' kernels"). A real light narrower than the bound (a strip light) comes out this
+/// wide, with the radiance that keeps its reflection; more samples per pixel make the kernels,
+/// and the bound, smaller.
+pub(super) fn smallest_light(cells: &[Vec2], distance: f32) -> Vec2 {
+    // Every 8th sample: a median needs no more, and a plane holds millions.
+    let (mut xs, mut ys): (Vec<f32>, Vec<f32>) =
+        cells.iter().step_by(8).map(|c| (c.x, c.y)).unzip();
+    let median = |v: &mut Vec<f32>| {
+        if v.is_empty() {
+            return 0.0;
+        }
+        let mid = v.len() / 2;
+        *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
+    };
+    Vec2::new(2.0 * median(&mut xs), 2.0 * median(&mut ys))
+        .max(Vec2::splat(SMALLEST_LIGHT_SHARE * distance))
+}
+
+/// The smallest light's side when the kernels are points, as a share of its distance from
+/// the camera: 2 mm at 10 m.
+const SMALLEST_LIGHT_SHARE: f32 = 2e-4;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -69,6 +69,7 @@
 //! | `direct_start` | starts far from a light's direct image moved onto it, fragments merged |
 //! | `lamp_starts` | one start per lamp whose reflections share a streak with another's |
 //! | `samples` | tracing and storing the plane samples, a coefficient from them |
+//! | `reweight` | a slope search's samples from one trace, weighted for each fit's lobe |
 //! | `near` | the samples a moving edge can change, found by bisection |
 //! | `kernel` | each sample's cell and kernel |
 //! | `control_variate` | the lobe Gaussian |
@@ -119,6 +120,7 @@ mod profile;
 mod ramps;
 mod region;
 mod repeats;
+mod reweight;
 mod samples;
 mod significance;
 mod split;
@@ -126,6 +128,7 @@ mod stacked;
 mod uncertainty;
 
 pub use options::{JointOptions, PixelShare, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
+pub use reweight::{ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
 pub use samples::effective_samples;
 pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty};
@@ -135,7 +138,7 @@ use optimise::optimise;
 use problem::{Problem, State};
 use region::{region, region_of_interest};
 use repeats::mean_and_spread;
-use samples::{sample_extent, trace_samples};
+use samples::sample_extent;
 use uncertainty::{facing_edges, uncertainties, FACING_REASON};
 
 /// The result of a joint fit.
@@ -318,23 +321,14 @@ pub fn fit_joint_with(
         ));
     }
     let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
-        trace_samples(
+        let fit = reweight::FitSamples {
             water_model,
             scene,
-            &options.model,
-            planes,
-            roi,
-            &pixels,
-            photo.width,
-            photo.height,
-            options.samples,
-            options.seed,
-            repeat,
-            draw,
-            options.control_variate,
+            pixels: &pixels,
+            size: (photo.width, photo.height),
             first_direct,
-            options.progress,
-        )
+        };
+        fit.samples(options, planes, roi, repeat, draw)
     };
     let problem_for = |repeat: u32| {
         let (stored, per_pixel_samples) = trace(&planes, &roi, repeat, 0);

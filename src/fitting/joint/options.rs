@@ -1,5 +1,6 @@
 //! The joint fit's options ([`JointOptions`]) and the limits on its samples.
 
+use super::reweight::Reweight;
 use super::Split;
 use crate::optics::ReflectionModel;
 use crate::progress::Reporter;
@@ -67,6 +68,10 @@ pub struct JointOptions<'a> {
     /// so that fits under different lobes compare their costs under one set of weights.
     /// Ignored when its length is not the fit's pixel count or with several repeats.
     pub row_scales: Option<&'a [f32]>,
+    /// A statistical water whose samples may come from a trace under a broader lobe, made
+    /// once for a whole search ([`Reweight`]): the fit's water model must be its target.
+    /// `None` by default (every fit traces its own).
+    pub reweight: Option<Reweight<'a>>,
 }
 
 impl JointOptions<'_> {
@@ -90,6 +95,7 @@ impl JointOptions<'_> {
             stacked_as_one: false,
             glitter_weights: false,
             row_scales: None,
+            reweight: None,
         }
     }
 }

@@ -20,7 +20,10 @@ use rayon::prelude::*;
 
 use super::control_variate::{self, LobeGaussian};
 use super::direct::{direct_hits, Hit, DIRECT_RAYS};
-use super::kernel::{cell_half_extents, kernel_coverage, LobeNeighbours, POINT_CELL};
+use super::kernel::{
+    cell_half_extents, kernel_coverage, smallest_light, LobeNeighbours, POINT_CELL,
+};
+use super::reweight::{PixelRecord, Recorded, SampleLobe};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::optics::{compact_strata, ReflectionModel};
@@ -65,7 +68,7 @@ pub(super) struct PlaneSamples {
     pub(super) reach: Vec<Vec2>,
     /// Per pixel, the control variate ([`LobeGaussian::NONE`] without).
     pub(super) gauss: Vec<LobeGaussian>,
-    /// The smallest width and height a light on this plane may take ([`smallest_light`]).
+    /// The smallest width and height a light on this plane may take ([`super::kernel::smallest_light`]).
     pub(super) min_size: Vec2,
     /// The plane's distance from the camera ([`LightPlane::camera_distance`]): the length
     /// the fit's smallest steps on this plane are shares of.
@@ -166,7 +169,46 @@ pub(super) fn trace_samples(
     first_direct: usize,
     progress: Reporter<'_>,
 ) -> (Vec<PlaneSamples>, u32) {
-    type Hits = (Vec<Hit>, Vec<LobeGaussian>);
+    let (stored, n, _) = trace_recorded(
+        water_model,
+        scene,
+        model,
+        planes,
+        roi,
+        pixels,
+        (width, height),
+        (samples, seed, repeat, draw),
+        gaussians,
+        first_direct,
+        false,
+        progress,
+    );
+    (stored, n)
+}
+
+/// [`trace_samples`], with, when `record` is set, what each stored sample needs to be
+/// weighted again for another lobe ([`super::reweight`]): per plane, per sample, its
+/// [`SampleLobe`], and per pixel the water point its control variate was matched at and
+/// the share of its camera rays that met the water. `draws` is (samples, seed, repeat,
+/// draw). With `record`, every sample that lands inside a region of interest is stored, of
+/// zero weight or not: under another lobe it may weigh.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn trace_recorded(
+    water_model: &dyn WaterModel,
+    scene: &Scene,
+    model: &ReflectionModel,
+    planes: &[&LightPlane],
+    roi: &[Rect],
+    pixels: &[u32],
+    (width, height): (u32, u32),
+    (samples, seed, repeat, draw): (u32, u64, u32, u32),
+    gaussians: bool,
+    first_direct: usize,
+    record: bool,
+    progress: Reporter<'_>,
+) -> (Vec<PlaneSamples>, u32, Option<Recorded>) {
+    // The record only when asked: a pixel of a plain trace carries no more than before.
+    type Hits = (Vec<Hit>, Vec<LobeGaussian>, Option<Box<PixelRecord>>);
     let lobe = lobe_strata(samples);
     let per_pixel_samples = effective_samples(samples);
     let direct_weight = per_pixel_samples as f32 / DIRECT_RAYS as f32;
@@ -193,12 +235,27 @@ pub(super) fn trace_samples(
             let (x, y) = (pixel % width, pixel / width);
             if index >= first_direct {
                 let hits = direct_hits(scene, planes, roi, x, y, width, height, direct_weight);
+                let lobes = if record {
+                    vec![SampleLobe::DIRECT; hits.len()]
+                } else {
+                    Vec::new()
+                };
+                let (hits, lobes) = in_store_order(hits, lobes, planes.len());
                 return (
-                    in_store_order(hits, planes.len()),
+                    hits,
                     vec![LobeGaussian::NONE; planes.len()],
+                    record.then(|| {
+                        Box::new(PixelRecord {
+                            lobes,
+                            water: None,
+                            drew: 0.0,
+                        })
+                    }),
                 );
             }
             let mut hits = Vec::new();
+            let mut lobes = Vec::new();
+            let mut first_water = None;
             let mut missed_water = 0u32;
             // The control variates, matched to the pixel's first camera ray to meet the water
             // before any of its lobe samples is drawn: they depend on no lobe sample, so the
@@ -239,6 +296,7 @@ pub(super) fn trace_samples(
                     continue;
                 };
                 let gauss = gauss.get_or_insert_with(|| {
+                    first_water = Some(water);
                     if !gaussians {
                         return vec![LobeGaussian::NONE; planes.len()];
                     }
@@ -302,19 +360,25 @@ pub(super) fn trace_samples(
                         if !roi[k].overlaps(&Rect::around(q, cell)) {
                             continue;
                         }
+                        // The density the sample was drawn with, per unit area of the plane.
+                        let area_pdf = s.pdf * s.wi.dot(plane.normal).abs() / (t * t);
                         let weight = if g.is_none() {
                             lobe_weight
+                        } else if area_pdf > 0.0 {
+                            // Less the Gaussian's density over it.
+                            lobe_weight - g.density(q) / area_pdf
                         } else {
-                            // The Gaussian's density over the density the sample was drawn
-                            // with, both per unit area of the plane.
-                            let area_pdf = s.pdf * s.wi.dot(plane.normal).abs() / (t * t);
-                            if area_pdf > 0.0 {
-                                lobe_weight - g.density(q) / area_pdf
-                            } else {
-                                lobe_weight
-                            }
+                            lobe_weight
                         };
-                        if weight != 0.0 {
+                        if record {
+                            hits.push((k as u16, q, cell, weight, half_sign, 0));
+                            lobes.push(SampleLobe {
+                                wo: water.wo,
+                                wi: s.wi,
+                                pdf: if lobe_weight != 0.0 { s.pdf } else { 0.0 },
+                                area_pdf,
+                            });
+                        } else if weight != 0.0 {
                             hits.push((k as u16, q, cell, weight, half_sign, 0));
                         }
                     }
@@ -327,7 +391,15 @@ pub(super) fn trace_samples(
             for g in gauss.iter_mut() {
                 g.mass *= drew;
             }
-            (in_store_order(hits, planes.len()), gauss)
+            let (hits, lobes) = in_store_order(hits, lobes, planes.len());
+            let recorded = record.then(|| {
+                Box::new(PixelRecord {
+                    lobes,
+                    water: first_water,
+                    drew,
+                })
+            });
+            (hits, gauss, recorded)
         })
         .collect();
     let mut slots: Vec<Option<Hits>> = (0..pixels.len()).map(|_| None).collect();
@@ -338,7 +410,7 @@ pub(super) fn trace_samples(
     // Each plane's samples, counted first so that its vectors are allocated once, at their
     // size.
     let mut counts = vec![0usize; planes.len()];
-    for (hits, _) in &per_pixel {
+    for (hits, _, _) in &per_pixel {
         for hit in hits {
             if let Some(c) = counts.get_mut(hit.0 as usize) {
                 *c += 1;
@@ -362,7 +434,7 @@ pub(super) fn trace_samples(
                 distance: planes[k].camera_distance(),
             };
             out.offsets.push(0);
-            for (hits, gauss) in &per_pixel {
+            for (hits, gauss, _) in &per_pixel {
                 out.gauss.push(gauss[k]);
                 for &(kk, p, cell, w, half, v_order) in hits {
                     if kk as usize == k {
@@ -390,7 +462,8 @@ pub(super) fn trace_samples(
             out
         })
         .collect();
-    (stored, per_pixel_samples)
+    let recorded = record.then(|| Recorded::gather(per_pixel, planes.len(), &counts));
+    (stored, per_pixel_samples, recorded)
 }
 
 /// One pixel's samples as the planes store them: in order of u (see [`PlaneSamples::near`];
@@ -398,8 +471,24 @@ pub(super) fn trace_samples(
 /// field, the entry of its plane's order in v ([`PlaneSamples::by_v`]) at its place among
 /// that plane's samples. Sorted here, in the parallel trace, rather than while the planes
 /// are gathered.
-fn in_store_order(mut hits: Vec<Hit>, planes: usize) -> Vec<Hit> {
-    hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
+fn in_store_order(
+    hits: Vec<Hit>,
+    lobes: Vec<SampleLobe>,
+    planes: usize,
+) -> (Vec<Hit>, Vec<SampleLobe>) {
+    let (mut hits, lobes) = if lobes.is_empty() {
+        let mut hits = hits;
+        hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
+        (hits, lobes)
+    } else {
+        // The same stable order for both.
+        let mut order: Vec<usize> = (0..hits.len()).collect();
+        order.sort_by(|&a, &b| hits[a].1.x.total_cmp(&hits[b].1.x));
+        (
+            order.iter().map(|&i| hits[i]).collect(),
+            order.iter().map(|&i| lobes[i]).collect(),
+        )
+    };
     // Every pixel's hits stay alive until all are stored: without the slack a growing vector
     // keeps (up to as much again), the joint fit peaks lower.
     hits.shrink_to_fit();
@@ -419,7 +508,7 @@ fn in_store_order(mut hits: Vec<Hit>, planes: usize) -> Vec<Hit> {
             hits[q].5 = v;
         }
     }
-    hits
+    (hits, lobes)
 }
 
 /// Pixels apart in the interleaved order of [`interleaved`].
@@ -440,37 +529,6 @@ fn shuffle(items: &mut [u32], rng: &mut Rng) {
         items.swap(i, j);
     }
 }
-
-/// The smallest width and height of a light whose samples' kernels have the half-widths
-/// `cells`: twice the median half-width along each axis, the kernels' typical full width (at
-/// least [`SMALLEST_LIGHT_SHARE`] of the plane's `distance` from the camera, when the cells
-/// are points). A narrower rectangle is seen only through the
-/// kernels' shape (its coefficient is the kernels' density where it lies, negative lobes
-/// included, from the few samples near it), so its coefficients are noise out of all
-/// proportion to their size, and the fit, which subtracts the estimated noise from its cost,
-/// rewards exactly that: two stacked lights 1.8 m apart came out as the lower light and a
-/// 1 mm sliver at 1400 times the radiance, at a cost 90 below the truth's (docs/decisions.md, "No light
-/// thinner than its samples' kernels"). A real light narrower than the bound (a strip light) comes out this
-/// wide, with the radiance that keeps its reflection; more samples per pixel make the kernels,
-/// and the bound, smaller.
-pub(super) fn smallest_light(cells: &[Vec2], distance: f32) -> Vec2 {
-    // Every 8th sample: a median needs no more, and a plane holds millions.
-    let (mut xs, mut ys): (Vec<f32>, Vec<f32>) =
-        cells.iter().step_by(8).map(|c| (c.x, c.y)).unzip();
-    let median = |v: &mut Vec<f32>| {
-        if v.is_empty() {
-            return 0.0;
-        }
-        let mid = v.len() / 2;
-        *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
-    };
-    Vec2::new(2.0 * median(&mut xs), 2.0 * median(&mut ys))
-        .max(Vec2::splat(SMALLEST_LIGHT_SHARE * distance))
-}
-
-/// The smallest light's side when the kernels are points, as a share of its distance from
-/// the camera: 2 mm at 10 m.
-const SMALLEST_LIGHT_SHARE: f32 = 2e-4;
 
 /// How far the photo could possibly move an edge: the extent of light k's stored samples.
 pub(super) fn sample_extent(p: &PlaneSamples) -> Option<Rect> {

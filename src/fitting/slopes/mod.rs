@@ -42,7 +42,7 @@ pub use uncertainty::{
 
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
-use super::joint::{fit_joint_with, JointOptions, Split, Uncertainty};
+use super::joint::{fit_joint_with, JointOptions, ProposalCache, Reweight, Split, Uncertainty};
 use super::{fit_paper_with, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::photo_in::Photo;
@@ -53,6 +53,11 @@ use crate::Result;
 /// The gloss of the water's microfacets under the statistical model: slope variance
 /// `1 / (e + 2)` = 5e-5, below any the photos show, so the waves' variances hold the lobe.
 pub const MICROFACET_GLOSS: f32 = 20000.0;
+
+/// The slope search's proposal (`joint::ProposalCache`), per axis, as a multiple of the
+/// start's variances: it covers fits from a quarter of it up to it, 0.4 to 1.6 times the
+/// start's, where the searches of the samples stay.
+pub const PROPOSAL_OVER_START: f32 = 1.6;
 
 /// The smallest and largest total slope variance searched.
 pub const VARIANCE_RANGE: (f32, f32) = (1e-4, 0.05);
@@ -198,6 +203,12 @@ pub fn estimate_slopes(
     let t = Instant::now();
     // The weights of the first fit's rows, which every later fit of the search takes.
     let search_scales: std::cell::OnceCell<Vec<f32>> = std::cell::OnceCell::new();
+    // Every fit of the search the proposal covers weighs the samples of its one trace
+    // (`ProposalCache`): their costs compare as fits from one set of samples do.
+    let proposal = ProposalCache::new(water_with_total(
+        surface,
+        start_variance.map(|v| (PROPOSAL_OVER_START * v).min(hi)),
+    ));
     // The `number`-th fit, at variances `v`.
     let eval = |v: [f32; 2], number: usize| -> Result<(Point, Vec<FittedLight>)> {
         final_fit.progress.stage(&format!(
@@ -206,8 +217,9 @@ pub fn estimate_slopes(
         ));
         // Weighted as the final fit is, every fit by the first one's weights (`row_scales`).
         let weighted = final_fit.glitter_weights;
+        let target = water_with_total(surface, v);
         let fit = fit_joint_with(
-            &water_with_total(surface, v),
+            &target,
             scene,
             photo,
             water,
@@ -216,6 +228,10 @@ pub fn estimate_slopes(
             &JointOptions {
                 glitter_weights: weighted,
                 row_scales: search_scales.get().map(|s| &s[..]),
+                reweight: Some(Reweight {
+                    cache: &proposal,
+                    target,
+                }),
                 ..search_options
             },
         )?;
