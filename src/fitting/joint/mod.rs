@@ -366,11 +366,17 @@ pub fn fit_joint_with(
         }
         set
     };
-    options.progress.stage(&format!(
-        "joint fit: tracing the footprints of {} pixels, {} samples each",
-        pixels.len(),
-        effective_samples(options.samples)
-    ));
+    let stage = options
+        .reweight
+        .and_then(|rw| rw.kept_trace_stage(options.model.gloss, &pixels, &planes, &roi))
+        .unwrap_or_else(|| {
+            format!(
+                "joint fit: tracing the footprints of {} pixels, {} samples each",
+                pixels.len(),
+                effective_samples(options.samples)
+            )
+        });
+    options.progress.stage(&stage);
     let mut problem = problem_for(0);
     if let Some(s) = given_scales {
         glitter::scale_rows(&mut problem, s);

@@ -318,6 +318,32 @@ impl FitSamples<'_> {
     }
 }
 
+impl Reweight<'_> {
+    /// The progress stage of a fit under this target (at the model's gloss `gloss`) over
+    /// `pixels`, `planes` and `roi` that weighs the trace the cache already holds, tracing
+    /// nothing; `None` for a fit that traces.
+    pub(super) fn kept_trace_stage(
+        &self,
+        gloss: f32,
+        pixels: &[u32],
+        planes: &[&LightPlane],
+        roi: &[Rect],
+    ) -> Option<String> {
+        let kept = self.cache.covers(&self.target, gloss)
+            && self
+                .cache
+                .traced
+                .get()
+                .is_some_and(|t| t.made_for(pixels, planes, roi));
+        kept.then(|| {
+            format!(
+                "joint fit: weighting the search's traced samples of {} pixels for this lobe",
+                pixels.len()
+            )
+        })
+    }
+}
+
 /// The samples of a fit under `rw.target` from the proposal's trace, traced on first use
 /// (with `model`, the fit's pixels `pixels` of a `size` image, `samples` per pixel and
 /// `seed`; the pixels from `first_direct` on see the walls directly): `None` when the trace

@@ -68,7 +68,8 @@ pub(super) struct PlaneSamples {
     pub(super) reach: Vec<Vec2>,
     /// Per pixel, the control variate ([`LobeGaussian::NONE`] without).
     pub(super) gauss: Vec<LobeGaussian>,
-    /// The smallest width and height a light on this plane may take ([`super::kernel::smallest_light`]).
+    /// The smallest width and height a light on this plane may take
+    /// ([`super::kernel::smallest_light`]).
     pub(super) min_size: Vec2,
     /// The plane's distance from the camera ([`LightPlane::camera_distance`]): the length
     /// the fit's smallest steps on this plane are shares of.
@@ -189,9 +190,10 @@ pub(super) fn trace_samples(
 /// [`trace_samples`], with, when `record` is set, what each stored sample needs to be
 /// weighted again for another lobe ([`super::reweight`]): per plane, per sample, its
 /// [`SampleLobe`], and per pixel the water point its control variate was matched at and
-/// the share of its camera rays that met the water. `draws` is (samples, seed, repeat,
-/// draw). With `record`, every sample that lands inside a region of interest is stored, of
-/// zero weight or not: under another lobe it may weigh.
+/// the share of its camera rays that met the water. The image's size and the draw's
+/// (samples, seed, repeat, draw) come as pairs and quadruples. With `record`, every sample
+/// that lands inside a region of interest is stored, of zero weight or not: under another
+/// lobe it may weigh.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn trace_recorded(
     water_model: &dyn WaterModel,
