@@ -127,19 +127,18 @@ pub(super) fn reweighted(
     plane: &LightPlane,
     target: &StatisticalSurface,
     model: &ReflectionModel,
-    gaussians: bool,
 ) -> PlaneSamples {
     let pixels = base.offsets.len() - 1;
     let gauss: Vec<LobeGaussian> = (0..pixels)
         .into_par_iter()
-        .map(|i| match (gaussians, water[i]) {
-            (true, Some(w)) => {
+        .map(|i| match water[i] {
+            Some(w) => {
                 let (dirs, count) = lobe_directions(target, model, &w);
                 let mut g = LobeGaussian::matched(plane, w.start, &dirs, count);
                 g.mass *= drew[i];
                 g
             }
-            _ => LobeGaussian::NONE,
+            None => LobeGaussian::NONE,
         })
         .collect();
     let weights: Vec<f32> = (0..pixels)
@@ -407,7 +406,6 @@ pub(super) fn from_proposal(
                 planes[k],
                 &rw.target,
                 model,
-                true,
             )
         })
         .collect();
@@ -478,7 +476,6 @@ mod tests {
                 &self.t.light.plane,
                 &water_with_total(self.surface, v),
                 &self.model,
-                true,
             )
         }
 
