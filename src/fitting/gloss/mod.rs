@@ -28,8 +28,14 @@
 //!   depends on the lobe, so the region still gains or loses a few hundred of its ~50,000
 //!   pixels at its dark fringe across `e` (on `gloss1000.png`), which add ~0 to the sum but
 //!   would change a mean.
-//! * The random numbers are common across candidates (one seed), so the cost is a smooth
-//!   function of `e` rather than one with fresh noise at every evaluation.
+//! * The candidates' fits weigh the samples of one trace (`joint::ProposalCache`), drawn from
+//!   a lobe broader than theirs and weighted for each gloss by importance sampling, so the
+//!   cost is a smooth function of `e` rather than one with fresh noise at every evaluation,
+//!   and a fit costs its descent, not a trace. A trace serves the glosses whose slope
+//!   variance is a quarter to the whole of its own: from `e` about `e / 1.6` to `2.5 e`
+//!   ([`PROPOSAL_BROADER`]). When the search steps beyond, it traces again from around the
+//!   step and makes again, on the new trace, the points that trace serves: costs of
+//!   different traces differ in level by more than the curve changes near its minimum.
 //! * The fits use the joint fit's full samples per pixel. With fewer the cost is not to be
 //!   trusted: the edge search picks, among thousands of rectangles, ones whose coefficients'
 //!   estimated noise (which the cost subtracts) happens to be large, and with a wide lobe and
@@ -64,9 +70,10 @@
 //! when the vertex is within the tolerance of the lowest point in a narrow bracket; the
 //! estimate is that vertex. On the samples that takes 3 evaluations from the right gloss, 7
 //! from a start 2 times off (`gloss1000.png` from 500) and 8 from one 2.5 times off
-//! (`gloss200.png` from 500), each about 1.6 s on 2 quiet cores (most of it the trace of the
-//! fit's footprints, redone at every gloss), and then one full joint fit at the estimate
-//! (about 3.3 s): 8.6 s in all for Table 1, 17 s for `gloss200.png`.
+//! (`gloss200.png` from 500, with 2 more made again on a second trace). On 2 cores a fit
+//! from the kept trace takes about 0.9 s, most of it the descent, and a trace about 1.3 s;
+//! then one full joint fit at the estimate (about 3.7 s): 8.1 s in all for Table 1, 16 s for
+//! `gloss200.png`.
 //!
 //! # Uncertainty
 //!
@@ -92,14 +99,16 @@ pub(super) mod search;
 
 use std::time::Instant;
 
-use super::joint::{fit_joint, JointOptions, PixelShare, Split, Uncertainty};
+use super::joint::{
+    fit_joint, JointOptions, Lobe, PixelShare, ProposalCache, Reweight, Split, Uncertainty,
+};
 use super::{fit_paper, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::{Error, Result};
-use search::{search, Point, Stop};
+use search::{search, Curve, Point, Stop};
 
 /// How to search for the gloss. What the fits themselves read (samples, pixels, repeats,
 /// seed) is the joint fit's options, given beside it to [`estimate_gloss`].
@@ -297,6 +306,7 @@ pub fn estimate_gloss(
         start: &start,
         options,
         fit: search_fit,
+        proposal: ProposalCache::new(proposal(x0)),
         evaluations: Vec::new(),
         failed: Vec::new(),
     };
@@ -305,7 +315,7 @@ pub fn estimate_gloss(
         x0,
         (lo, hi),
         ("gloss", &|e| format!("{e:.0}")),
-        |x| cost.point(x),
+        &mut cost,
     )?;
     timings.push((
         format!("search ({} evaluations)", cost.evaluations.len()),
@@ -441,6 +451,20 @@ fn region_gloss(options: &GlossSearch, start: f32) -> f32 {
     (start / 4.0).max(options.min_gloss)
 }
 
+/// How much broader than the glosses it is first drawn for a search's proposal is, in slope
+/// variance: from `ln e` it serves the glosses from about `e / 1.6` to `2.5 e`
+/// ([`crate::fitting::joint::TARGET_OVER_PROPOSAL`]), the search's first three points and
+/// a step of up to a factor 2 either way from its best ([`GlossSearch::max_step_ln`]).
+const PROPOSAL_BROADER: f32 = 1.6;
+
+/// The lobe a search's trace is drawn from when it is to serve `x = ln e` and the glosses
+/// around it ([`PROPOSAL_BROADER`]).
+fn proposal(x: f64) -> Lobe {
+    // Gloss e has the slope variance 1 / (e + 2).
+    let gloss = (x.exp() as f32 + 2.0) / PROPOSAL_BROADER - 2.0;
+    Lobe::Exact { gloss }
+}
+
 /// The cost of a candidate gloss, with a record of every evaluation.
 struct Cost<'a> {
     scene: &'a Scene,
@@ -450,13 +474,15 @@ struct Cost<'a> {
     start: &'a [FittedLight],
     options: &'a GlossSearch,
     fit: SearchFit<'a>,
+    /// The trace every fit weighs (module doc).
+    proposal: ProposalCache,
     /// (ln e, cost), in the order evaluated.
     evaluations: Vec<(f64, f64)>,
     /// Evaluations whose fit broke down (module doc), for a warning.
     failed: Vec<f32>,
 }
 
-impl Cost<'_> {
+impl Curve for &mut Cost<'_> {
     /// The cost at `x = ln e` as a point of the curve.
     fn point(&mut self, x: f64) -> Result<Point> {
         let gloss = x.exp() as f32;
@@ -480,6 +506,10 @@ impl Cost<'_> {
                 split: false,
                 region_gloss: Some(region_gloss(self.options, self.fit.model.gloss)),
                 direct_view: self.fit.direct_view,
+                reweight: Some(Reweight {
+                    cache: &self.proposal,
+                    target: Lobe::Exact { gloss },
+                }),
                 ..JointOptions::new(
                     ReflectionModel {
                         gloss,
@@ -502,5 +532,18 @@ impl Cost<'_> {
             s,
             variance: fit.residual_variance,
         })
+    }
+
+    /// Whether the kept trace serves gloss `exp(x)`.
+    fn serves(&self, x: f64) -> bool {
+        self.proposal.covers(&Lobe::Exact {
+            gloss: x.exp() as f32,
+        })
+    }
+
+    /// A new trace, drawn from a lobe broader than the lower of `next` and `best` by
+    /// [`PROPOSAL_BROADER`].
+    fn rebase(&mut self, next: f64, best: f64) {
+        self.proposal = ProposalCache::new(proposal(next.min(best)));
     }
 }

@@ -26,17 +26,44 @@ pub(in crate::fitting) struct Found {
     pub(in crate::fitting) stop: Stop,
 }
 
-/// Minimises `cost` over `x = ln e` in [lo, hi] from `x0` (module doc, "Search"); `cost`
-/// gives the point at x (an infinite cost: no evidence there). The same search serves any
-/// parameter that acts multiplicatively (the waves' slope variances, [`crate::fitting::slopes`]):
-/// `name` says what `x` is the logarithm of, `show` prints `exp(x)`, in the error when every
-/// fit broke down.
+/// The cost curve a search walks. Its points compare only while they stand on one basis (the
+/// fits of the gloss search weigh the samples of one trace, which serves a range of glosses,
+/// [`crate::fitting::joint::ProposalCache`]); a closure's points always compare.
+pub(in crate::fitting) trait Curve {
+    /// The point at `x` (an infinite cost: no evidence there).
+    fn point(&mut self, x: f64) -> Result<Point>;
+
+    /// Whether a point at `x` compares with the points made on the present basis.
+    fn serves(&self, _x: f64) -> bool {
+        true
+    }
+
+    /// Moves to a basis that serves both `next` and `best` and the points a first step
+    /// either side of `best` ([`GlossSearch::first_step_ln`]); the search then makes again
+    /// the points it has that the new basis serves.
+    fn rebase(&mut self, _next: f64, _best: f64) {}
+}
+
+impl<F: FnMut(f64) -> Result<Point>> Curve for F {
+    fn point(&mut self, x: f64) -> Result<Point> {
+        self(x)
+    }
+}
+
+/// Minimises `cost` over `x = ln e` in [lo, hi] from `x0` (module doc, "Search"). The same
+/// search serves any parameter that acts multiplicatively (the waves' slope variances,
+/// [`crate::fitting::slopes`]): `name` says what `x` is the logarithm of, `show` prints
+/// `exp(x)`, in the error when every fit broke down. When the next point is one `cost` does
+/// not serve on its basis, the basis moves ([`Curve::rebase`]) and the points so far are made
+/// again on it, those it does not serve dropped; while fewer than three would be left, the
+/// best point's neighbours a first step away are added (or the point midway to the next). Points made again do not count
+/// against [`GlossSearch::max_evaluations`].
 pub(in crate::fitting) fn search(
     opts: &GlossSearch,
     x0: f64,
     (lo, hi): (f64, f64),
     (name, show): (&str, &dyn Fn(f64) -> String),
-    mut cost: impl FnMut(f64) -> Result<Point>,
+    mut cost: impl Curve,
 ) -> Result<Found> {
     let h = opts.first_step_ln as f64;
     let tol = opts.tolerance_ln as f64;
@@ -47,8 +74,10 @@ pub(in crate::fitting) fn search(
     let centre = x0.clamp(lo + h0, hi - h0);
     let mut pts = Vec::new();
     for x in [centre - h0, centre, centre + h0] {
-        pts.push(cost(x)?);
+        pts.push(cost.point(x)?);
     }
+    // Points made at new places (not made again on a new basis).
+    let mut made = pts.len();
     loop {
         pts.sort_by(|p, q| p.x.total_cmp(&q.x));
         let ib = (0..pts.len())
@@ -139,14 +168,43 @@ pub(in crate::fitting) fn search(
             }
             (None, None) => unreachable!("three points at least"),
         };
-        if pts.len() >= opts.max_evaluations {
+        if made >= opts.max_evaluations {
             return Ok(Found {
                 x: best.x,
                 sigma_ln: None,
                 stop: Stop::OutOfEvaluations,
             });
         }
-        pts.push(cost(next)?);
+        if !cost.serves(next) {
+            cost.rebase(next, best.x);
+            let mut again = Vec::with_capacity(pts.len() + 2);
+            for p in &pts {
+                if cost.serves(p.x) {
+                    again.push(cost.point(p.x)?);
+                }
+            }
+            for x in [best.x - h0, best.x + h0, 0.5 * (best.x + next)] {
+                let new = x != next
+                    && (lo..=hi).contains(&x)
+                    && cost.serves(x)
+                    && again.iter().all(|p: &Point| p.x != x);
+                if again.len() < 2 && new {
+                    again.push(cost.point(x)?);
+                    made += 1;
+                }
+            }
+            if again.len() < 2 {
+                return Err(Error::NothingFound(format!(
+                    "the {name} search could not go on from {} towards {}: too few of its \
+                     points compare there",
+                    show(best.x.exp()),
+                    show(next.exp())
+                )));
+            }
+            pts = again;
+        }
+        pts.push(cost.point(next)?);
+        made += 1;
     }
 }
 
@@ -197,10 +255,16 @@ mod tests {
     /// points it evaluated.
     fn run(opts: &GlossSearch, f: impl Fn(f64) -> f64) -> (Found, Vec<f64>) {
         let mut xs = Vec::new();
-        let found = search(opts, 500f64.ln(), (50f64.ln(), 5000f64.ln()), GLOSS, |x| {
-            xs.push(x);
-            Ok(pt(x, f(x)))
-        })
+        let found = search(
+            opts,
+            500f64.ln(),
+            (50f64.ln(), 5000f64.ln()),
+            GLOSS,
+            |x: f64| {
+                xs.push(x);
+                Ok(pt(x, f(x)))
+            },
+        )
         .unwrap();
         (found, xs)
     }
@@ -258,7 +322,7 @@ mod tests {
         let (found, _) = run(&options(), f);
         assert!((found.x.exp() / 160.0 - 1.0).abs() < 0.05, "{found:?}");
         // And nothing but broken fits is an error, not a guess.
-        let all_broken = search(&options(), 6.0, (4.0, 8.0), GLOSS, |x| {
+        let all_broken = search(&options(), 6.0, (4.0, 8.0), GLOSS, |x: f64| {
             Ok(pt(x, f64::INFINITY))
         });
         assert!(matches!(all_broken, Err(Error::NothingFound(_))));
@@ -274,5 +338,60 @@ mod tests {
         assert_eq!(found.stop, Stop::OutOfEvaluations);
         assert_eq!(xs.len(), 4);
         assert!(found.sigma_ln.is_none());
+    }
+
+    /// A curve whose points compare only on one basis: each basis serves `x` in
+    /// `[b, b + ln 4]` and adds a level of its own, far larger than the curve's changes.
+    struct Based {
+        truth: f64,
+        basis: f64,
+        bases: usize,
+        xs: Vec<f64>,
+    }
+
+    impl Curve for &mut Based {
+        fn point(&mut self, x: f64) -> Result<Point> {
+            assert!(self.serves(x), "{x} asked off the basis {}", self.basis);
+            self.xs.push(x);
+            Ok(pt(x, skewed(x, self.truth) + 1e5 * self.bases as f64))
+        }
+
+        fn serves(&self, x: f64) -> bool {
+            (self.basis..=self.basis + 4f64.ln()).contains(&x)
+        }
+
+        fn rebase(&mut self, next: f64, best: f64) {
+            self.basis = next.min(best) - 1.6f64.ln();
+            self.bases += 1;
+        }
+    }
+
+    /// From a start 5 times off either way, the search moves its basis as it goes and still
+    /// finds the minimum, each basis's points compared among themselves only (a point of an
+    /// older basis would sit 1e5 higher and never be the best).
+    #[test]
+    fn a_search_that_moves_its_basis_compares_points_of_one() {
+        for truth in [100.0, 2500.0] {
+            let x0 = 500f64.ln();
+            let mut curve = Based {
+                truth,
+                basis: x0 - 1.6f64.ln(),
+                bases: 0,
+                xs: Vec::new(),
+            };
+            let found = search(
+                &options(),
+                x0,
+                (50f64.ln(), 5000f64.ln()),
+                GLOSS,
+                &mut curve,
+            )
+            .unwrap();
+            let e = found.x.exp();
+            assert_eq!(found.stop, Stop::Converged, "truth {truth}: {found:?}");
+            assert!((e / truth - 1.0).abs() < 0.03, "truth {truth}: found {e}");
+            assert!(curve.bases >= 1, "truth {truth}: never moved");
+            assert!(found.sigma_ln.is_some_and(|s| s > 0.0));
+        }
     }
 }

@@ -69,7 +69,8 @@
 //! | `direct_start` | starts far from a light's direct image moved onto it, fragments merged |
 //! | `lamp_starts` | one start per lamp whose reflections share a streak with another's |
 //! | `samples` | tracing and storing the plane samples, a coefficient from them |
-//! | `reweight` | a slope search's samples from one trace, weighted for each fit's lobe |
+//! | `reweight` | a search's samples from one trace, weighted for each fit's lobe |
+//! | `proposal` | the lobe that trace is drawn from, the targets it serves |
 //! | `near` | the samples a moving edge can change, found by bisection |
 //! | `kernel` | each sample's cell and kernel |
 //! | `control_variate` | the lobe Gaussian |
@@ -117,6 +118,7 @@ mod options;
 mod pieces;
 mod problem;
 mod profile;
+mod proposal;
 mod ramps;
 mod region;
 mod repeats;
@@ -128,7 +130,7 @@ mod stacked;
 mod uncertainty;
 
 pub use options::{JointOptions, PixelShare, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
-pub use reweight::{ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
+pub use proposal::{Lobe, ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
 pub use samples::effective_samples;
 pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty};
@@ -321,7 +323,7 @@ pub fn fit_joint_with(
         ));
     }
     let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
-        let fit = reweight::FitSamples {
+        let fit = proposal::FitSamples {
             water_model,
             scene,
             pixels: &pixels,
@@ -368,7 +370,7 @@ pub fn fit_joint_with(
     };
     let stage = options
         .reweight
-        .and_then(|rw| rw.kept_trace_stage(options.model.gloss, &pixels, &planes, &roi))
+        .and_then(|rw| rw.kept_trace_stage(&pixels, &planes, &roi))
         .unwrap_or_else(|| {
             format!(
                 "joint fit: tracing the footprints of {} pixels, {} samples each",

@@ -1,6 +1,6 @@
 //! The joint fit's options ([`JointOptions`]) and the limits on its samples.
 
-use super::reweight::Reweight;
+use super::proposal::Reweight;
 use super::Split;
 use crate::optics::ReflectionModel;
 use crate::progress::Reporter;

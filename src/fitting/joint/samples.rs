@@ -15,7 +15,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::control_variate::{self, LobeGaussian};
@@ -181,17 +181,27 @@ pub(super) fn trace_samples(
         (samples, seed, repeat, draw),
         gaussians,
         first_direct,
-        false,
+        Record::Nothing,
         progress,
     );
     (stored, n)
 }
 
-/// [`trace_samples`], with, when `record` is set, what each stored sample needs to be
-/// weighted again for another lobe ([`super::reweight`]): per plane, per sample, its
-/// [`SampleLobe`], and per pixel the water point its control variate was matched at and
-/// the share of its camera rays that met the water. The image's size and the draw's
-/// (samples, seed, repeat, draw) come as pairs and quadruples. With `record`, every sample
+/// What a trace keeps besides its samples, for them to be weighted again for another lobe
+/// ([`super::reweight`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Record {
+    Nothing,
+    /// Each stored sample's [`SampleLobe`], and per pixel the water point its control
+    /// variate was matched at and the share of its camera rays that met the water.
+    Lobes,
+    /// The same and each sample's lobe axis, where the axis differs from point to point
+    /// (the exact model's waves).
+    LobesAndAxes,
+}
+
+/// [`trace_samples`], with what `record` asks for per plane, per sample and per pixel. The image's size and the draw's
+/// (samples, seed, repeat, draw) come as pairs and quadruples. With a record, every sample
 /// that lands inside a region of interest is stored, of zero weight or not: under another
 /// lobe it may weigh.
 #[allow(clippy::too_many_arguments)]
@@ -206,9 +216,10 @@ pub(super) fn trace_recorded(
     (samples, seed, repeat, draw): (u32, u64, u32, u32),
     gaussians: bool,
     first_direct: usize,
-    record: bool,
+    record: Record,
     progress: Reporter<'_>,
 ) -> (Vec<PlaneSamples>, u32, Option<Recorded>) {
+    let (axes, record) = (record == Record::LobesAndAxes, record != Record::Nothing);
     // The record only when asked: a pixel of a plain trace carries no more than before.
     type Hits = (Vec<Hit>, Vec<LobeGaussian>, Option<Box<PixelRecord>>);
     let lobe = lobe_strata(samples);
@@ -242,13 +253,19 @@ pub(super) fn trace_recorded(
                 } else {
                     Vec::new()
                 };
-                let (hits, lobes) = in_store_order(hits, lobes, planes.len());
+                let axes = if axes {
+                    vec![Vec3::ZERO; hits.len()]
+                } else {
+                    Vec::new()
+                };
+                let (hits, lobes, axes) = in_store_order(hits, lobes, axes, planes.len());
                 return (
                     hits,
                     vec![LobeGaussian::NONE; planes.len()],
                     record.then(|| {
                         Box::new(PixelRecord {
                             lobes,
+                            axes,
                             water: None,
                             drew: 0.0,
                         })
@@ -257,6 +274,7 @@ pub(super) fn trace_recorded(
             }
             let mut hits = Vec::new();
             let mut lobes = Vec::new();
+            let mut sample_axes = Vec::new();
             let mut first_water = None;
             let mut missed_water = 0u32;
             // The control variates, matched to the pixel's first camera ray to meet the water
@@ -380,6 +398,9 @@ pub(super) fn trace_recorded(
                                 pdf: if lobe_weight != 0.0 { s.pdf } else { 0.0 },
                                 area_pdf,
                             });
+                            if axes {
+                                sample_axes.push(water.normal);
+                            }
                         } else if weight != 0.0 {
                             hits.push((k as u16, q, cell, weight, half_sign, 0));
                         }
@@ -393,10 +414,11 @@ pub(super) fn trace_recorded(
             for g in gauss.iter_mut() {
                 g.mass *= drew;
             }
-            let (hits, lobes) = in_store_order(hits, lobes, planes.len());
+            let (hits, lobes, axes) = in_store_order(hits, lobes, sample_axes, planes.len());
             let recorded = record.then(|| {
                 Box::new(PixelRecord {
                     lobes,
+                    axes,
                     water: first_water,
                     drew,
                 })
@@ -476,19 +498,26 @@ pub(super) fn trace_recorded(
 fn in_store_order(
     hits: Vec<Hit>,
     lobes: Vec<SampleLobe>,
+    axes: Vec<Vec3>,
     planes: usize,
-) -> (Vec<Hit>, Vec<SampleLobe>) {
-    let (mut hits, lobes) = if lobes.is_empty() {
+) -> (Vec<Hit>, Vec<SampleLobe>, Vec<Vec3>) {
+    let (mut hits, lobes, axes) = if lobes.is_empty() {
         let mut hits = hits;
         hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
-        (hits, lobes)
+        (hits, lobes, axes)
     } else {
-        // The same stable order for both.
+        // The same stable order for all (the axes only when recorded).
         let mut order: Vec<usize> = (0..hits.len()).collect();
         order.sort_by(|&a, &b| hits[a].1.x.total_cmp(&hits[b].1.x));
+        let axes = if axes.is_empty() {
+            axes
+        } else {
+            order.iter().map(|&i| axes[i]).collect()
+        };
         (
             order.iter().map(|&i| hits[i]).collect(),
             order.iter().map(|&i| lobes[i]).collect(),
+            axes,
         )
     };
     // Every pixel's hits stay alive until all are stored: without the slack a growing vector
@@ -510,7 +539,7 @@ fn in_store_order(
             hits[q].5 = v;
         }
     }
-    (hits, lobes)
+    (hits, lobes, axes)
 }
 
 /// Pixels apart in the interleaved order of [`interleaved`].

@@ -42,7 +42,9 @@ pub use uncertainty::{
 
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
-use super::joint::{fit_joint_with, JointOptions, ProposalCache, Reweight, Split, Uncertainty};
+use super::joint::{
+    fit_joint_with, JointOptions, Lobe, ProposalCache, Reweight, Split, Uncertainty,
+};
 use super::{fit_paper_with, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::photo_in::Photo;
@@ -205,10 +207,13 @@ pub fn estimate_slopes(
     let search_scales: std::cell::OnceCell<Vec<f32>> = std::cell::OnceCell::new();
     // Every fit of the search the proposal covers weighs the samples of its one trace
     // (`ProposalCache`): their costs compare as fits from one set of samples do.
-    let proposal = ProposalCache::new(water_with_total(
-        surface,
-        start_variance.map(|v| (PROPOSAL_OVER_START * v).min(hi)),
-    ));
+    let proposal = ProposalCache::new(Lobe::Statistical {
+        water: water_with_total(
+            surface,
+            start_variance.map(|v| (PROPOSAL_OVER_START * v).min(hi)),
+        ),
+        gloss: model.gloss,
+    });
     // The `number`-th fit, at variances `v`.
     let eval = |v: [f32; 2], number: usize| -> Result<(Point, Vec<FittedLight>)> {
         final_fit.progress.stage(&format!(
@@ -230,7 +235,10 @@ pub fn estimate_slopes(
                 row_scales: search_scales.get().map(|s| &s[..]),
                 reweight: Some(Reweight {
                     cache: &proposal,
-                    target,
+                    target: Lobe::Statistical {
+                        water: target,
+                        gloss: model.gloss,
+                    },
                 }),
                 ..search_options
             },
@@ -272,7 +280,7 @@ pub fn estimate_slopes(
             (anchor[axis] as f64).ln(),
             (lo_ln, hi_ln),
             (name, show),
-            |x| {
+            |x: f64| {
                 let mut v = anchor;
                 v[axis] = x.exp() as f32;
                 // The same variances to rounding (the logarithm and back).
