@@ -317,15 +317,20 @@ pub fn estimate_gloss(
         ("gloss", &|e| format!("{e:.0}")),
         &mut cost,
     )?;
+    // The kept trace is freed before the final fit traces its own: the peak memory is the
+    // larger of the two, not their sum.
+    let (evaluations, failed) = {
+        let done = cost;
+        (done.evaluations, done.failed)
+    };
     timings.push((
-        format!("search ({} evaluations)", cost.evaluations.len()),
+        format!("search ({} evaluations)", evaluations.len()),
         t.elapsed().as_secs_f64(),
     ));
     let gloss = found.x.exp() as f32;
-    if !cost.failed.is_empty() {
+    if !failed.is_empty() {
         warnings.push(format!(
-            "the joint fit broke down (no positive cost) at gloss {:?}; those were left out",
-            cost.failed
+            "the joint fit broke down (no positive cost) at gloss {failed:?}; those were left out"
         ));
     }
     match found.stop {
@@ -367,8 +372,7 @@ pub fn estimate_gloss(
     Ok(GlossEstimate {
         gloss,
         sigma_ln: found.sigma_ln.map(|s| s as f32),
-        evaluations: cost
-            .evaluations
+        evaluations: evaluations
             .iter()
             .map(|&(x, s)| (x.exp() as f32, s))
             .collect(),

@@ -7,7 +7,6 @@ use glam::Vec3;
 
 use super::reweight::{reweighted, Recorded};
 use super::samples::PlaneSamples;
-use super::samples::Record;
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::optics::{GaussianSlopes, ReflectionModel};
@@ -69,15 +68,6 @@ impl Lobe {
                 a.surface == b.surface
             }
             _ => false,
-        }
-    }
-
-    /// What a trace drawn from this lobe records to be weighted for others: the lobe axis of
-    /// each sample too where the axis varies (the exact model's waves).
-    pub(super) fn record(&self) -> Record {
-        match self {
-            Lobe::Exact { .. } => Record::LobesAndAxes,
-            Lobe::Statistical { .. } => Record::Lobes,
         }
     }
 
@@ -286,7 +276,7 @@ pub(super) fn from_proposal(
             (samples, seed, 0, 0),
             true,
             first_direct,
-            cache.proposal.record(),
+            true,
             progress,
         );
         ProposalTrace {
@@ -297,7 +287,7 @@ pub(super) fn from_proposal(
             per_pixel_samples,
             recorded: recorded.unwrap_or(Recorded {
                 lobes: Vec::new(),
-                axes: Vec::new(),
+                rays: Vec::new(),
                 water: Vec::new(),
                 drew: Vec::new(),
             }),
@@ -311,7 +301,7 @@ pub(super) fn from_proposal(
             reweighted(
                 &traced.stored[k],
                 &traced.recorded.lobes[k],
-                &traced.recorded.axes[k],
+                &traced.recorded.rays,
                 &traced.recorded.water,
                 &traced.recorded.drew,
                 planes[k],

@@ -37,8 +37,8 @@ use crate::render::WaterPoint;
 /// What a stored sample needs to be weighted for another lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct SampleLobe {
-    /// The camera ray's direction back to the camera.
-    pub wo: Vec3,
+    /// Which of its pixel's recorded camera rays it was drawn from ([`PixelRecord::rays`]).
+    pub ray: u8,
     /// The lobe sample's direction.
     pub wi: Vec3,
     /// The solid-angle density it was drawn with; 0 when the ray met something before the
@@ -52,31 +52,34 @@ pub(super) struct SampleLobe {
 impl SampleLobe {
     /// A direct pixel's sample.
     pub const DIRECT: SampleLobe = SampleLobe {
-        wo: Vec3::ZERO,
+        ray: 0,
         wi: Vec3::ZERO,
         pdf: -1.0,
         area_pdf: 0.0,
     };
 }
 
-/// One pixel's record from the trace: its stored samples' lobes in store order (and their
-/// lobe axes, when recorded), the water point its control variate was matched at (`None`:
-/// no camera ray met the water, or a direct pixel), and the share of its camera rays that
-/// met the water.
+/// A camera ray that met the water: its direction back to the camera, and the lobe's axis
+/// there (the mesh's shading normal, or the mean plane's normal).
+pub(super) type CameraRay = (Vec3, Vec3);
+
+/// One pixel's record from the trace: its stored samples' lobes in store order, its camera
+/// rays that met the water (in the order traced), the water point its control variate was
+/// matched at (`None`: no camera ray met the water, or a direct pixel), and the share of its
+/// camera rays that met the water.
 #[derive(Clone, Debug, Default)]
 pub(super) struct PixelRecord {
     pub lobes: Vec<SampleLobe>,
-    pub axes: Vec<Vec3>,
+    pub rays: Vec<CameraRay>,
     pub water: Option<WaterPoint>,
     pub drew: f32,
 }
 
-/// A recorded trace: per plane, the lobes of its stored samples (in the plane's order) and,
-/// where the lobe's axis varies from point to point, each one's axis (else empty), and per
-/// pixel the control variate's water point and share.
+/// A recorded trace: per plane, the lobes of its stored samples (in the plane's order), and
+/// per pixel its camera rays, the control variate's water point and share.
 pub(super) struct Recorded {
     pub lobes: Vec<Vec<SampleLobe>>,
-    pub axes: Vec<Vec<Vec3>>,
+    pub rays: Vec<Vec<CameraRay>>,
     pub water: Vec<Option<WaterPoint>>,
     pub drew: Vec<f32>,
 }
@@ -92,7 +95,7 @@ impl Recorded {
     ) -> Self {
         let mut lobes: Vec<Vec<SampleLobe>> =
             counts.iter().map(|&n| Vec::with_capacity(n)).collect();
-        let mut axes: Vec<Vec<Vec3>> = vec![Vec::new(); planes];
+        let mut rays = Vec::with_capacity(per_pixel.len());
         let mut water = Vec::with_capacity(per_pixel.len());
         let mut drew = Vec::with_capacity(per_pixel.len());
         for (hits, _, record) in per_pixel {
@@ -102,18 +105,14 @@ impl Recorded {
                     l.push(*lobe);
                 }
             }
-            for (hit, axis) in hits.iter().zip(&record.axes) {
-                if let Some(a) = axes.get_mut(hit.0 as usize) {
-                    a.push(*axis);
-                }
-            }
+            rays.push(record.rays);
             water.push(record.water);
             drew.push(record.drew);
         }
         debug_assert_eq!(lobes.len(), planes);
         Recorded {
             lobes,
-            axes,
+            rays,
             water,
             drew,
         }
@@ -121,15 +120,14 @@ impl Recorded {
 }
 
 /// The samples of `plane` recorded under a proposal lobe (`base`, `lobes` its samples'
-/// lobes, `axes` their lobe axes or empty for the statistical model's one plane, `water`
-/// and `drew` per pixel), weighted for the lobe `target` (`model` gives the
+/// lobes, `rays`, `water` and `drew` per pixel), weighted for the lobe `target` (`model` gives the
 /// IOR and the geometry term; module doc): each sample's weight is the target's `f cos` over the proposal's density,
 /// less the target's control variate, and each pixel's Gaussian is matched to the target.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn reweighted(
     base: &PlaneSamples,
     lobes: &[SampleLobe],
-    axes: &[Vec3],
+    rays: &[Vec<CameraRay>],
     water: &[Option<WaterPoint>],
     drew: &[f32],
     plane: &LightPlane,
@@ -157,22 +155,20 @@ pub(super) fn reweighted(
             let g = gauss[i];
             let old = &base.weights[r.clone()];
             let points = &base.points[r.clone()];
-            // Without recorded axes, the mean plane's (which the statistical lobe knows).
-            let axes = axes.get(r.clone());
+            let rays = &rays[i];
             lobes[r]
                 .iter()
                 .zip(points)
                 .zip(old)
-                .enumerate()
-                .map(move |(j, ((l, q), &w))| {
+                .map(move |((l, q), &w)| {
                     if l.pdf < 0.0 {
                         return w;
                     }
-                    let lobe = if l.pdf > 0.0 {
-                        let axis = axes.map_or(Vec3::ZERO, |a| a[j]);
-                        target.eval_cos(&target_model, axis, l.wo, l.wi) / l.pdf
-                    } else {
-                        0.0
+                    let lobe = match rays.get(l.ray as usize) {
+                        Some(&(wo, axis)) if l.pdf > 0.0 => {
+                            target.eval_cos(&target_model, axis, wo, l.wi) / l.pdf
+                        }
+                        _ => 0.0,
                     };
                     if l.area_pdf > 0.0 {
                         lobe - g.density(*q) / l.area_pdf
@@ -248,7 +244,7 @@ mod tests {
                 (samples, seed, 0, 0),
                 true,
                 t.pixels.len(),
-                lobe.record(),
+                true,
                 crate::progress::Reporter::default(),
             );
             (stored, n, recorded.expect("recorded"))
@@ -259,7 +255,7 @@ mod tests {
             reweighted(
                 &stored[0],
                 &rec.lobes[0],
-                &rec.axes[0],
+                &rec.rays,
                 &rec.water,
                 &rec.drew,
                 &self.t.light.plane,

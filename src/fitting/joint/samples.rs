@@ -14,8 +14,9 @@
 //! rectangles.
 
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use rayon::prelude::*;
 
 use super::control_variate::{self, LobeGaussian};
@@ -39,33 +40,35 @@ pub(super) const JOINT_STREAM: u64 = 3 << 48;
 
 /// Stored samples of one light's plane: per fitted pixel, a range of points and weights, and
 /// which of the pixel's two independent halves each belongs to (what the coefficients'
-/// variance is estimated from).
+/// variance is estimated from). Where the samples lie is shared (`Arc`) between the sets
+/// that weigh them differently ([`super::reweight`]): only the weights and the control
+/// variates are a set's own.
 pub(super) struct PlaneSamples {
     /// Per pixel, where its samples start (and, at `i + 1`, end) in the per-sample vectors.
-    pub(super) offsets: Vec<u32>,
+    pub(super) offsets: Arc<Vec<u32>>,
     /// Per pixel, the bounding box of its samples' kernels ([`Rect::EMPTY`] for a pixel with
     /// none).
-    pub(super) bbox: Vec<Rect>,
+    pub(super) bbox: Arc<Vec<Rect>>,
     /// Per sample, where it lands (plane coordinates).
-    pub(super) points: Vec<Vec2>,
+    pub(super) points: Arc<Vec<Vec2>>,
     /// Per sample, the half-widths of its kernel along the plane's axes (see
     /// [`cell_half_extents`] and [`super::kernel`]); negative for a direct pixel's sample,
     /// whose kernel is the plain box of its stratum ([`super::direct`]).
-    pub(super) cells: Vec<Vec2>,
+    pub(super) cells: Arc<Vec<Vec2>>,
     /// Per sample, its weight less the control variate's (see [`super::control_variate`]):
     /// negative where the Gaussian outweighs the lobe. A direct pixel's samples (see
     /// [`super::direct`]) weigh the pixel's sample count over its strata.
     pub(super) weights: Vec<f32>,
     /// Per sample, which of the pixel's two independent halves it belongs to (+1 or -1); 0
     /// for a direct pixel's samples, whose coefficient is exact (no noise to measure).
-    pub(super) halves: Vec<f32>,
+    pub(super) halves: Arc<Vec<f32>>,
     /// Per sample, its pixel's samples in order of v, as offsets from the pixel's first
     /// sample (each pixel's samples are stored in order of u): with both orders, the samples
     /// near an edge of either axis are found by bisection ([`Self::near`]).
-    pub(super) by_v: Vec<u16>,
+    pub(super) by_v: Arc<Vec<u16>>,
     /// Per pixel, the largest reach of its samples' kernels along u and along v (at least
     /// [`POINT_CELL`]).
-    pub(super) reach: Vec<Vec2>,
+    pub(super) reach: Arc<Vec<Vec2>>,
     /// Per pixel, the control variate ([`LobeGaussian::NONE`] without).
     pub(super) gauss: Vec<LobeGaussian>,
     /// The smallest width and height a light on this plane may take
@@ -181,27 +184,18 @@ pub(super) fn trace_samples(
         (samples, seed, repeat, draw),
         gaussians,
         first_direct,
-        Record::Nothing,
+        false,
         progress,
     );
     (stored, n)
 }
 
-/// What a trace keeps besides its samples, for them to be weighted again for another lobe
-/// ([`super::reweight`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Record {
-    Nothing,
-    /// Each stored sample's [`SampleLobe`], and per pixel the water point its control
-    /// variate was matched at and the share of its camera rays that met the water.
-    Lobes,
-    /// The same and each sample's lobe axis, where the axis differs from point to point
-    /// (the exact model's waves).
-    LobesAndAxes,
-}
-
-/// [`trace_samples`], with what `record` asks for per plane, per sample and per pixel. The image's size and the draw's
-/// (samples, seed, repeat, draw) come as pairs and quadruples. With a record, every sample
+/// [`trace_samples`], with, when `record` is set, what each stored sample needs to be
+/// weighted again for another lobe ([`super::reweight`]): per plane, per sample, its
+/// [`SampleLobe`], and per pixel its camera rays' directions back to the camera and lobe
+/// axes, the water point its control variate was matched at and the share of its camera
+/// rays that met the water. The image's size and the draw's
+/// (samples, seed, repeat, draw) come as pairs and quadruples. With `record`, every sample
 /// that lands inside a region of interest is stored, of zero weight or not: under another
 /// lobe it may weigh.
 #[allow(clippy::too_many_arguments)]
@@ -216,10 +210,9 @@ pub(super) fn trace_recorded(
     (samples, seed, repeat, draw): (u32, u64, u32, u32),
     gaussians: bool,
     first_direct: usize,
-    record: Record,
+    record: bool,
     progress: Reporter<'_>,
 ) -> (Vec<PlaneSamples>, u32, Option<Recorded>) {
-    let (axes, record) = (record == Record::LobesAndAxes, record != Record::Nothing);
     // The record only when asked: a pixel of a plain trace carries no more than before.
     type Hits = (Vec<Hit>, Vec<LobeGaussian>, Option<Box<PixelRecord>>);
     let lobe = lobe_strata(samples);
@@ -253,19 +246,14 @@ pub(super) fn trace_recorded(
                 } else {
                     Vec::new()
                 };
-                let axes = if axes {
-                    vec![Vec3::ZERO; hits.len()]
-                } else {
-                    Vec::new()
-                };
-                let (hits, lobes, axes) = in_store_order(hits, lobes, axes, planes.len());
+                let (hits, lobes) = in_store_order(hits, lobes, planes.len());
                 return (
                     hits,
                     vec![LobeGaussian::NONE; planes.len()],
                     record.then(|| {
                         Box::new(PixelRecord {
                             lobes,
-                            axes,
+                            rays: Vec::new(),
                             water: None,
                             drew: 0.0,
                         })
@@ -274,7 +262,7 @@ pub(super) fn trace_recorded(
             }
             let mut hits = Vec::new();
             let mut lobes = Vec::new();
-            let mut sample_axes = Vec::new();
+            let mut rays = Vec::new();
             let mut first_water = None;
             let mut missed_water = 0u32;
             // The control variates, matched to the pixel's first camera ray to meet the water
@@ -315,6 +303,11 @@ pub(super) fn trace_recorded(
                     }
                     continue;
                 };
+                // Its place among the pixel's recorded camera rays (each met the water).
+                let ray = rays.len();
+                if record {
+                    rays.push((water.wo, water.normal));
+                }
                 let gauss = gauss.get_or_insert_with(|| {
                     first_water = Some(water);
                     if !gaussians {
@@ -393,14 +386,11 @@ pub(super) fn trace_recorded(
                         if record {
                             hits.push((k as u16, q, cell, weight, half_sign, 0));
                             lobes.push(SampleLobe {
-                                wo: water.wo,
+                                ray: ray as u8,
                                 wi: s.wi,
                                 pdf: if lobe_weight != 0.0 { s.pdf } else { 0.0 },
                                 area_pdf,
                             });
-                            if axes {
-                                sample_axes.push(water.normal);
-                            }
                         } else if weight != 0.0 {
                             hits.push((k as u16, q, cell, weight, half_sign, 0));
                         }
@@ -414,11 +404,11 @@ pub(super) fn trace_recorded(
             for g in gauss.iter_mut() {
                 g.mass *= drew;
             }
-            let (hits, lobes, axes) = in_store_order(hits, lobes, sample_axes, planes.len());
+            let (hits, lobes) = in_store_order(hits, lobes, planes.len());
             let recorded = record.then(|| {
                 Box::new(PixelRecord {
                     lobes,
-                    axes,
+                    rays,
                     water: first_water,
                     drew,
                 })
@@ -444,46 +434,55 @@ pub(super) fn trace_recorded(
     let stored = (0..planes.len())
         .map(|k| {
             let n = counts[k];
-            let mut out = PlaneSamples {
-                offsets: Vec::with_capacity(pixels.len() + 1),
-                bbox: Vec::with_capacity(pixels.len()),
-                points: Vec::with_capacity(n),
-                cells: Vec::with_capacity(n),
-                weights: Vec::with_capacity(n),
-                halves: Vec::with_capacity(n),
-                by_v: Vec::with_capacity(n),
-                reach: Vec::with_capacity(pixels.len()),
-                gauss: Vec::with_capacity(pixels.len()),
-                min_size: Vec2::ZERO,
-                distance: planes[k].camera_distance(),
-            };
-            out.offsets.push(0);
+            let mut offsets = Vec::with_capacity(pixels.len() + 1);
+            let mut bbox = Vec::with_capacity(pixels.len());
+            let mut points = Vec::with_capacity(n);
+            let mut cells = Vec::with_capacity(n);
+            let mut weights = Vec::with_capacity(n);
+            let mut halves = Vec::with_capacity(n);
+            let mut by_v = Vec::with_capacity(n);
+            let mut reaches = Vec::with_capacity(pixels.len());
+            let mut gausses = Vec::with_capacity(pixels.len());
+            offsets.push(0);
             for (hits, gauss, _) in &per_pixel {
-                out.gauss.push(gauss[k]);
+                gausses.push(gauss[k]);
+                let first = points.len();
                 for &(kk, p, cell, w, half, v_order) in hits {
                     if kk as usize == k {
-                        out.points.push(p);
-                        out.cells.push(cell);
-                        out.weights.push(w);
-                        out.halves.push(half);
-                        out.by_v.push(v_order);
+                        points.push(p);
+                        cells.push(cell);
+                        weights.push(w);
+                        halves.push(half);
+                        by_v.push(v_order);
                     }
                 }
-                let first = *out.offsets.last().unwrap_or(&0) as usize;
                 let mut bb = Rect::EMPTY;
                 let mut reach = Vec2::splat(POINT_CELL);
-                for (p, h) in out.points[first..].iter().zip(&out.cells[first..]) {
+                for (p, h) in points[first..].iter().zip(&cells[first..]) {
                     bb = bb.union(&Rect::around(*p, h.abs()));
                     reach = reach.max(h.abs());
                 }
-                out.bbox.push(bb);
-                out.reach.push(reach);
-                out.offsets.push(out.points.len() as u32);
+                bbox.push(bb);
+                reaches.push(reach);
+                offsets.push(points.len() as u32);
             }
+            let distance = planes[k].camera_distance();
             // From the water pixels' samples alone: the bound is about the lobes' kernels.
-            let lobe_samples = out.offsets[first_direct.min(pixels.len())] as usize;
-            out.min_size = smallest_light(&out.cells[..lobe_samples], out.distance);
-            out
+            let lobe_samples = offsets[first_direct.min(pixels.len())] as usize;
+            let min_size = smallest_light(&cells[..lobe_samples], distance);
+            PlaneSamples {
+                offsets: Arc::new(offsets),
+                bbox: Arc::new(bbox),
+                points: Arc::new(points),
+                cells: Arc::new(cells),
+                weights,
+                halves: Arc::new(halves),
+                by_v: Arc::new(by_v),
+                reach: Arc::new(reaches),
+                gauss: gausses,
+                min_size,
+                distance,
+            }
         })
         .collect();
     let recorded = record.then(|| Recorded::gather(per_pixel, planes.len(), &counts));
@@ -498,26 +497,19 @@ pub(super) fn trace_recorded(
 fn in_store_order(
     hits: Vec<Hit>,
     lobes: Vec<SampleLobe>,
-    axes: Vec<Vec3>,
     planes: usize,
-) -> (Vec<Hit>, Vec<SampleLobe>, Vec<Vec3>) {
-    let (mut hits, lobes, axes) = if lobes.is_empty() {
+) -> (Vec<Hit>, Vec<SampleLobe>) {
+    let (mut hits, lobes) = if lobes.is_empty() {
         let mut hits = hits;
         hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
-        (hits, lobes, axes)
+        (hits, lobes)
     } else {
-        // The same stable order for all (the axes only when recorded).
+        // The same stable order for both.
         let mut order: Vec<usize> = (0..hits.len()).collect();
         order.sort_by(|&a, &b| hits[a].1.x.total_cmp(&hits[b].1.x));
-        let axes = if axes.is_empty() {
-            axes
-        } else {
-            order.iter().map(|&i| axes[i]).collect()
-        };
         (
             order.iter().map(|&i| hits[i]).collect(),
             order.iter().map(|&i| lobes[i]).collect(),
-            axes,
         )
     };
     // Every pixel's hits stay alive until all are stored: without the slack a growing vector
@@ -539,7 +531,7 @@ fn in_store_order(
             hits[q].5 = v;
         }
     }
-    (hits, lobes, axes)
+    (hits, lobes)
 }
 
 /// Pixels apart in the interleaved order of [`interleaved`].
@@ -600,7 +592,7 @@ mod tests {
             let c = (0..t.pixels.len())
                 .map(|i| planes[0].coefficient(i, &rect, inv).0 as f64)
                 .collect();
-            (planes[0].points.clone(), c)
+            (planes[0].points.to_vec(), c)
         };
         let (points0, c0) = sums(0);
         let (points1, c1) = sums(1);

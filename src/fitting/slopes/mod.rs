@@ -320,6 +320,9 @@ pub fn estimate_slopes(
             )),
         }
     }
+    // The kept trace is freed before the final fit traces its own: the peak memory is the
+    // larger of the two, not their sum.
+    drop(proposal);
     let evaluations: Vec<([f32; 2], f64)> = made.iter().map(|m| (m.0, m.1.s)).collect();
     timings.push((
         format!("slope search ({} evaluations)", evaluations.len()),
