@@ -326,20 +326,22 @@ fn joint_splits_overlapping_streaks() {
     }
 }
 
-/// Repeated joint fits of the stacked lights from the reflections alone (`--repeats 4`,
+/// Repeated joint fits of the stacked lights from the reflections alone (`--repeats 2`,
 /// without the direct view): their mean, with the spread of
-/// the 4 fits from independent samples added to the uncertainties. The lower light's error
+/// the 2 fits from independent samples added to the uncertainties. The lower light's error
 /// through the overlap is a bias common to the fits (it grows into the overlap: top +11 %,
 /// radiance -10 % for seed 1), which no spread of them shows; it is the curvature of the
 /// noise-corrected cost that reports it (see `joint_splits_overlapping_streaks`). Held
 /// here: every parameter of both lights that has a sigma within 6 of it for the default seed
-/// (the facing edges the split made are unconstrained, with none).
+/// (the facing edges the split made are unconstrained, with none); measured: 1.1 at most.
+/// Two repeats rather than more: the spread is added the same way for any number, and each
+/// repeat is a whole fit.
 #[test]
 fn repeated_fits_cover_the_stacked_errors() {
     let truths = samples::stacked_lights();
     // --joint-samples given: the user's choice stands (no refit over every pixel), and the
     // warning says which settings fit such lights more closely.
-    let report = fit_report_options("stacked.png", reflections_only(), 4, Some(72));
+    let report = fit_report_options("stacked.png", reflections_only(), 2, Some(72));
     assert_eq!(
         report.settings.joint_pixels.as_deref(),
         Some("checkerboard")
@@ -364,7 +366,7 @@ fn repeated_fits_cover_the_stacked_errors() {
         let (z, z_rad) = sigmas(light, truth);
         let (e, r) = errors(light, truth);
         eprintln!(
-            "stacked x4: edges % {:?} radiance {:.3} %, sigmas {z:?} {z_rad:.2}",
+            "stacked x2: edges % {:?} radiance {:.3} %, sigmas {z:?} {z_rad:.2}",
             percent(e),
             100.0 * r
         );
