@@ -3,7 +3,7 @@
 //! own frame, from the same photo. Nothing of the fit may be a length in scene units.
 //!
 //! The photo is `table1.png` (one white light, 3 x 3 m at 10 m); the rigs scale the paper's
-//! scene by 0.01 (a tabletop miniature: 3 cm at 10 cm), 0.5, 2 and 10, turn it 35 degrees
+//! scene by 0.01 (a tabletop miniature: 3 cm at 10 cm) and by 10, turn it 35 degrees
 //! about the vertical and move it 1.4 km from the origin. Turning the scene turns the lobe's
 //! sampling frame against it, so the fit's own noise differs from the unrigged fit's; the
 //! lights still agree within 0.1 %, and the fits under one turn agree with each other far
@@ -145,7 +145,8 @@ fn a_scene_scaled_turned_and_moved_gives_the_same_lights_in_its_own_frame() {
     let turned = Rig::new(1.0);
     let reference = fit(&turned.write("scene-rig-1.gltf"), Some(&turned));
     assert_same(&reference, &alone, 1e-3, "turned and moved");
-    for scale in [0.01, 0.5, 2.0, 10.0] {
+    // A hundredth and ten times: the scales between fail only if these do.
+    for scale in [0.01, 10.0] {
         let rig = Rig::new(scale);
         let lights = fit(&rig.write(&format!("scene-rig-{scale}.gltf")), Some(&rig));
         let what = format!("scaled {scale}");
