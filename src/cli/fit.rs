@@ -73,8 +73,9 @@ pub struct Args {
     /// Blinn-Phong gloss e of the water (dimensionless, > 0; typical 100-2000, rough to calm;
     /// the samples: 500), overriding its material's roughness; or "auto" to estimate it from
     /// the photo together with the lights (starting from the material's; 3 to 12 joint fits
-    /// over a quarter of the pixels and a final one: on the samples 3 to 6 times as long as
-    /// with the gloss given). Not with --method paper.
+    /// over a quarter of the pixels, weighing the samples of one or a few traces, and a final
+    /// one: on the samples 2.5 to 5 times as long as with the gloss given). Not with --method
+    /// paper.
     #[arg(long, value_name = "E|auto")]
     pub gloss: Option<GlossArg>,
     /// The photo's exposure: its linear values are divided by it to give radiance, in the

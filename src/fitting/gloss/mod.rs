@@ -81,8 +81,8 @@
 //! the cost by the residual variance per degree of freedom `s2`, so `sigma(ln e) = sqrt(s2 / k)`.
 //! That is the photo's statistical limit (pixel noise independent): it leaves out the model's
 //! own errors and the Monte Carlo noise of the fits, and is a lower bound. On the samples it
-//! is about 0.06 %, while the estimates (`tests/gloss.rs`) are 200.4 for e = 200, 504.7 for
-//! 500 and 1006.2 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
+//! is about 0.06 %, while the estimates (`tests/gloss.rs`) are 201.0 for e = 200, 504.3 for
+//! 500 and 1004.1 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
 //! measured when the search was written). Read the estimate as good to a few percent. (With the joint
 //! fit's own default of 72 samples e = 200 came out 223: see [`SEARCH_SAMPLES`].)
 //!
