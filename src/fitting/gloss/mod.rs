@@ -455,17 +455,18 @@ fn region_gloss(options: &GlossSearch, start: f32) -> f32 {
     (start / 4.0).max(options.min_gloss)
 }
 
-/// How much broader than the glosses it is first drawn for a search's proposal is, in slope
-/// variance: from `ln e` it serves the glosses from about `e / 1.6` to `2.5 e`
-/// ([`crate::fitting::joint::TARGET_OVER_PROPOSAL`]), the search's first three points and
-/// a step of up to a factor 2 either way from its best ([`GlossSearch::max_step_ln`]).
+/// How much broader than the gloss it is drawn for a search's proposal is, in slope
+/// variance: from `e` it serves the glosses from about `e / 1.6` to `2.5 e`
+/// ([`crate::fitting::joint::TARGET_OVER_PROPOSAL`]): the search's first three points, and a
+/// step of up to a factor 2 towards narrower lobes ([`GlossSearch::max_step_ln`]); a step
+/// to a broader one beyond `e / 1.6` traces again.
 const PROPOSAL_BROADER: f32 = 1.6;
 
 /// The lobe a search's trace is drawn from when it is to serve `x = ln e` and the glosses
 /// around it ([`PROPOSAL_BROADER`]).
 fn proposal(x: f64) -> Lobe {
-    // Gloss e has the slope variance 1 / (e + 2).
-    let gloss = (x.exp() as f32 + 2.0) / PROPOSAL_BROADER - 2.0;
+    // Gloss e has the slope variance 1 / (e + 2); no lobe is broader than e = 0's.
+    let gloss = ((x.exp() as f32 + 2.0) / PROPOSAL_BROADER - 2.0).max(0.0);
     Lobe::Exact { gloss }
 }
 
@@ -549,5 +550,36 @@ impl Curve for &mut Cost<'_> {
     /// [`PROPOSAL_BROADER`].
     fn rebase(&mut self, next: f64, best: f64) {
         self.proposal = ProposalCache::new(proposal(next.min(best)));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A search's proposal serves the gloss it is drawn for, the first points either side
+    /// of it, a step of a factor 2 towards narrower lobes and down to about `e / 1.6`, not
+    /// below; its gloss stays a gloss however low the gloss asked for.
+    #[test]
+    fn a_proposal_serves_the_steps_around_its_gloss() {
+        let first = GlossSearch::default().first_step_ln as f64;
+        for e in [50.0f64, 500.0, 5000.0] {
+            let cache = ProposalCache::new(proposal(e.ln()));
+            for x in [
+                e.ln(),
+                e.ln() - first,
+                e.ln() + first,
+                (2.0 * e).ln(),
+                (e / 1.55).ln(),
+            ] {
+                let gloss = x.exp() as f32;
+                assert!(cache.covers(&Lobe::Exact { gloss }), "{e}: {gloss}");
+            }
+            for gloss in [e / 1.7, 2.6 * e] {
+                let gloss = gloss as f32;
+                assert!(!cache.covers(&Lobe::Exact { gloss }), "{e}: {gloss}");
+            }
+        }
+        assert_eq!(proposal(0.5f64.ln()), Lobe::Exact { gloss: 0.0 });
     }
 }
