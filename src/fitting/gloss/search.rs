@@ -56,8 +56,8 @@ impl<F: FnMut(f64) -> Result<Point>> Curve for F {
 /// `exp(x)`, in the error when every fit broke down. When the next point is one `cost` does
 /// not serve on its basis, the basis moves ([`Curve::rebase`]) and the points so far are made
 /// again on it, those it does not serve dropped; while fewer than three would be left, the
-/// best point's neighbours a first step away are added (or the point midway to the next). Points made again do not count
-/// against [`GlossSearch::max_evaluations`].
+/// best point's neighbours a first step away are added (or the point midway to the next).
+/// Points made again do not count against [`GlossSearch::max_evaluations`].
 pub(in crate::fitting) fn search(
     opts: &GlossSearch,
     x0: f64,
