@@ -56,23 +56,41 @@ pub fn fit(scene: &Path, photo: &Path, extra: &[&str]) -> Vec<String> {
     args
 }
 
-/// Every file under `dir` (recursively; symlinks as their targets' paths) with its bytes.
+/// Every file under `dir` (recursively; symlinks as their targets' paths) with its bytes. A
+/// file that vanishes while it is read (a running fit renaming or removing its temporaries,
+/// as the interrupt tests watch it do) is left out.
 pub fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     let mut out = BTreeMap::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return out;
     };
+    // The value, or `None` for a file gone since it was listed; any other error fails.
+    fn present<T>(r: std::io::Result<T>) -> Option<T> {
+        match r {
+            Ok(v) => Some(v),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(e) => panic!("{e}"),
+        }
+    }
     for e in entries {
-        let path = e.unwrap().path();
-        let meta = std::fs::symlink_metadata(&path).unwrap();
+        let Some(e) = present(e) else { continue };
+        let path = e.path();
+        let Some(meta) = present(std::fs::symlink_metadata(&path)) else {
+            continue;
+        };
         if meta.file_type().is_symlink() {
-            let target = std::fs::read_link(&path).unwrap();
+            let Some(target) = present(std::fs::read_link(&path)) else {
+                continue;
+            };
             out.insert(path, target.to_string_lossy().as_bytes().to_vec());
         } else if meta.is_dir() {
             out.insert(path.clone(), b"<folder>".to_vec());
             out.extend(snapshot(&path));
         } else if meta.is_file() {
-            out.insert(path.clone(), std::fs::read(&path).unwrap());
+            let Some(bytes) = present(std::fs::read(&path)) else {
+                continue;
+            };
+            out.insert(path.clone(), bytes);
         } else {
             out.insert(path, b"<special>".to_vec());
         }
