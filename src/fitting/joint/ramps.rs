@@ -156,8 +156,13 @@ pub(super) struct EdgeRamps {
     /// Whether any ramp starts at or before the last grid point (otherwise the value is
     /// `constant` everywhere).
     pub(super) kinked: bool,
-    /// Per ramp: the grid point it is recorded at, its slope and its slope times its kink
-    /// (absolute and signed).
+    /// The ramps whose kinks lie before the first grid point, summed: each is linear over
+    /// the whole grid, so they add one slope and one slope times kink (absolute and signed)
+    /// rather than a ramp each. Once the window is narrow, most of the samples an edge moves
+    /// through are such: their kernels straddle the whole window.
+    base: [[f64; 2]; 2],
+    /// Per ramp with its kink on the grid: the grid point it is recorded at, its slope and
+    /// its slope times its kink (absolute and signed).
     kinks: Vec<(usize, [f64; 2], [f64; 2])>,
     /// [`Self::values`]' bins: per grid point, the slopes and slopes times kinks of the ramps
     /// recorded there.
@@ -174,6 +179,7 @@ impl EdgeRamps {
             grid,
             constant: [0.0; 2],
             kinked: false,
+            base: [[0.0; 2]; 2],
             kinks: Vec::new(),
             slope: Vec::new(),
         }
@@ -182,6 +188,7 @@ impl EdgeRamps {
     pub(super) fn clear(&mut self, grid: usize) {
         self.constant = [0.0; 2];
         self.kinked = false;
+        self.base = [[0.0; 2]; 2];
         self.kinks.clear();
         self.grid = grid;
     }
@@ -193,8 +200,16 @@ impl EdgeRamps {
 
     fn kink(&mut self, at: f64, abs: f64, signed: f64) {
         let f = (at - self.lo) * self.inv_step;
+        if f < 0.0 {
+            self.kinked = true;
+            self.base[0][0] += abs;
+            self.base[0][1] += signed;
+            self.base[1][0] += abs * at;
+            self.base[1][1] += signed * at;
+            return;
+        }
         // Truncation is the floor here (f >= 0), without a call to libm's floor.
-        let j = if f < 0.0 { 0 } else { f as usize + 1 };
+        let j = f as usize + 1;
         if j < self.grid {
             self.kinked = true;
             self.kinks.push((j, [abs, signed], [abs * at, signed * at]));
@@ -210,7 +225,7 @@ impl EdgeRamps {
     ) {
         // Unstable but deterministic: the same ramps give the same order on every run.
         self.kinks.sort_unstable_by_key(|k| k.0);
-        let (mut s, mut sk) = ([0f64; 2], [0f64; 2]);
+        let [mut s, mut sk] = self.base;
         let mut from = 0;
         let mut next = 0;
         while from < self.grid {
@@ -233,8 +248,9 @@ impl EdgeRamps {
         }
     }
 
-    /// How many ramps start on the grid: [`Self::for_each_piece`] sorts them, so it is for
-    /// a few; [`Self::values`] takes any number at the same cost.
+    /// How many ramps start on the grid after its first point: [`Self::for_each_piece`]
+    /// sorts them, so it is for a few; [`Self::values`] takes any number at the same cost.
+    /// The ramps before the grid are one linear term ([`Self::base`]), free to either.
     pub(super) fn ramp_count(&self) -> usize {
         self.kinks.len()
     }
@@ -251,7 +267,7 @@ impl EdgeRamps {
                 bin[1][c] += slope_kink[c];
             }
         }
-        let (mut s, mut sk) = ([0f64; 2], [0f64; 2]);
+        let [mut s, mut sk] = self.base;
         for (j, (a, b)) in abs.iter_mut().zip(signed.iter_mut()).enumerate() {
             for c in 0..2 {
                 s[c] += self.slope[j][0][c];
@@ -410,6 +426,23 @@ mod tests {
             }
             let (mut abs, mut signed) = (vec![0f32; grid], vec![0f32; grid]);
             ramps.values(&mut abs, &mut signed);
+            // The cells reaching below the grid (their ramps summed as one linear term; a max
+            // edge's opposite edge lies on the grid, so only a min edge has them) and those
+            // kinked on it, read as pieces: the same values.
+            assert_eq!(ramps.base != [[0.0; 2]; 2], min_edge);
+            assert!(ramps.ramp_count() > 0);
+            let mut covered = 0;
+            ramps.for_each_piece(|j0, j1, intercept, slope| {
+                assert_eq!(j0, covered);
+                covered = j1;
+                for j in j0..j1 {
+                    let t = lo as f64 + j as f64 * step as f64;
+                    let (a, b) = (intercept[0] + slope[0] * t, intercept[1] + slope[1] * t);
+                    assert!((a - abs[j] as f64).abs() < 1e-4, "{min_edge} {j}: {a}");
+                    assert!((b - signed[j] as f64).abs() < 1e-4, "{min_edge} {j}: {b}");
+                }
+            });
+            assert_eq!(covered, grid);
             for j in 0..grid {
                 let t = lo + j as f32 * step;
                 let (mut want_abs, mut want_signed) = (0f32, 0f32);
