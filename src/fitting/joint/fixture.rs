@@ -4,7 +4,8 @@
 //! `direct_start` and `lamp_starts`).
 
 use super::region::{region, region_of_interest};
-use super::samples::{trace_samples, PlaneSamples};
+use super::samples::PlaneSamples;
+use super::trace::trace_samples;
 use crate::fitting::rect::Rect;
 use crate::fitting::{FittedLight, StreakObservation};
 use crate::optics::ReflectionModel;

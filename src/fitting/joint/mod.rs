@@ -127,6 +127,7 @@ mod samples;
 mod significance;
 mod split;
 mod stacked;
+mod trace;
 mod uncertainty;
 
 pub use options::{JointOptions, PixelShare, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};

@@ -167,7 +167,7 @@ pub(super) struct FitSamples<'a> {
 
 impl FitSamples<'_> {
     /// The samples of `planes` inside `roi` for repeat `repeat` and draw `draw` (see
-    /// [`super::samples::trace_samples`]) under `options`: the first set of the first
+    /// [`super::trace::trace_samples`]) under `options`: the first set of the first
     /// repeat weighted from the proposal's trace where `options.reweight` covers the fit,
     /// every other set traced.
     pub fn samples(
@@ -197,7 +197,7 @@ impl FitSamples<'_> {
         }) {
             return out;
         }
-        super::samples::trace_samples(
+        super::trace::trace_samples(
             self.water_model,
             self.scene,
             &options.model,
@@ -265,7 +265,7 @@ pub(super) fn from_proposal(
         return None;
     }
     let traced = cache.traced.get_or_init(|| {
-        let (stored, per_pixel_samples, recorded) = super::samples::trace_recorded(
+        let (stored, per_pixel_samples, recorded) = super::trace::trace_recorded(
             cache.proposal.water_model(),
             scene,
             &cache.proposal.model(model),

@@ -196,7 +196,7 @@ pub(super) fn reweighted(
 #[cfg(test)]
 mod tests {
     use super::super::fixture::{table3_light0, Table3Light0};
-    use super::super::samples::trace_recorded;
+    use super::super::trace::trace_recorded;
     use super::*;
     use crate::fitting::rect::Rect;
     use crate::fitting::slopes::{water_with_total, MICROFACET_GLOSS};
