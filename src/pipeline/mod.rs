@@ -20,12 +20,12 @@ pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
 pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
 pub use water_choice::{
     fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_CORRELATION,
-    EXACT_MIN_EXPLAINED, FLAT_SHARE,
+    EXACT_MIN_EXPLAINED, FLAT_SHARE, START_MAX_CORRELATION,
 };
 
 use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
-use crate::fitting::joint::{fit_joint_with, JointOptions, Split, Uncertainty};
+use crate::fitting::joint::{fit_joint_with, JointOptions, Split, StartGate, Uncertainty};
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -213,6 +213,7 @@ pub fn fit(
         timings: Vec::new(),
         modelled: Vec::new(),
         splits: Vec::new(),
+        stopped_at_start: false,
     };
     let water_model = if observations.is_empty() {
         match settings.water {
@@ -275,6 +276,9 @@ struct Found {
     /// The start lights the last joint fit explained as two: an overlap refit from the same
     /// start tries each only that way.
     splits: Vec<Split>,
+    /// Whether the last joint fit ended at its start (its start gate said so): no light,
+    /// and `modelled` is the start lights' expected image.
+    stopped_at_start: bool,
 }
 
 impl Found {
@@ -364,18 +368,31 @@ impl Run<'_> {
         found.uncertainties = outcome.uncertainty;
         found.modelled = outcome.modelled;
         found.splits = outcome.splits;
+        found.stopped_at_start = outcome.stopped_at_start;
         found.warnings.extend(outcome.warnings);
         Ok(())
     }
 
     /// The joint fit from the paper's lights in `found`, then the refit of lights that share
-    /// a streak.
-    fn refine(&self, j: &JointSettings, found: &mut Found) -> Result<()> {
+    /// a streak; `gate` may end the fit at its start ([`JointOptions::start_gate`]).
+    fn refine(
+        &self,
+        j: &JointSettings,
+        found: &mut Found,
+        gate: Option<StartGate<'_>>,
+    ) -> Result<()> {
         self.progress
             .stage(&format!("joint fit of {} light(s)", found.lights.len()));
         let start = std::mem::take(&mut found.lights);
         let options = self.joint_options(j, j.reading);
-        self.joint(&ExactSurface, &start, &options, "joint", found)?;
+        let first = JointOptions {
+            start_gate: gate,
+            ..options
+        };
+        self.joint(&ExactSurface, &start, &first, "joint", found)?;
+        if found.stopped_at_start {
+            return Ok(());
+        }
         self.refit_overlaps(&ExactSurface, &start, &options, j, found)
     }
 

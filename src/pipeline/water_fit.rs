@@ -4,11 +4,11 @@
 
 use super::water_choice::{
     fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_EXPLAINED,
-    FLAT_SHARE,
+    FLAT_SHARE, START_MAX_CORRELATION,
 };
 use super::{Found, GlossFit, Method, Run, EXACT_MIN_CORRELATION};
 use crate::fitting::gloss::GlossSearch;
-use crate::fitting::joint::JointOptions;
+use crate::fitting::joint::{JointOptions, StartGate};
 use crate::fitting::slopes::{estimate_slopes, water_with_total, MICROFACET_GLOSS};
 use crate::fitting::{self, FitOptions};
 use crate::optics::{GaussianSlopes, ReflectionModel};
@@ -56,7 +56,7 @@ impl Run<'_> {
         match (settings.water, &settings.method) {
             (WaterChoice::Statistical, method) => self.statistical(method, found, "forced", None),
             (WaterChoice::Exact, method) => {
-                self.exact(method, found)?;
+                self.exact(method, found, None)?;
                 // Measured all the same, for the report.
                 let fine = fine_structure(&self.photo.radiance, self.photo.width, &found.modelled);
                 Ok(WaterModelUsed {
@@ -67,7 +67,7 @@ impl Run<'_> {
             }
             // The paper's per-streak estimate has no expected image to compare.
             (WaterChoice::Auto, method @ Method::Paper) => {
-                self.exact(method, found)?;
+                self.exact(method, found, None)?;
                 Ok(WaterModelUsed {
                     chosen: "detected",
                     reason: "the paper's method has no expected image to compare with the \
@@ -88,8 +88,15 @@ impl Run<'_> {
                 let warnings = found.warnings.len();
                 // The exact fit as it would be made alone (with the gloss search when asked),
                 // then the test on its expected image: where it passes, nothing is done twice.
-                self.exact(method, found)?;
-                if found.lights.is_empty() {
+                // Where the start lights' expected image already shows fine structure
+                // unrelated to the photo's, the fit ends there (`clearly_not_exact`).
+                let photo = self.photo;
+                let gate = |modelled: &[(u32, [f32; 3])]| {
+                    !fine_structure(&photo.radiance, photo.width, modelled)
+                        .is_some_and(|f| f.clearly_not_exact())
+                };
+                self.exact(method, found, Some(StartGate(&gate)))?;
+                if found.lights.is_empty() && !found.stopped_at_start {
                     return Ok(WaterModelUsed {
                         chosen: "detected",
                         reason: "no light to fit: nothing to compare".into(),
@@ -117,9 +124,18 @@ impl Run<'_> {
                 found.lights.clear();
                 found.uncertainties.clear();
                 found.skipped.clear();
+                let at_start = found.stopped_at_start;
+                found.stopped_at_start = false;
                 let mut used = self.statistical(method, found, "detected", correlation)?;
                 used.exact_explained = exact_explained;
                 used.reason = choice_reason(fine);
+                if at_start {
+                    used.reason.push_str(&format!(
+                        ", both measured at the paper's estimate of the lights, already far \
+                         from the exact model there (correlation under \
+                         {START_MAX_CORRELATION}): the exact fit was not made"
+                    ));
+                }
                 Ok(used)
             }
         }
@@ -143,8 +159,9 @@ impl Run<'_> {
     }
 
     /// The exact model's fit: the paper's estimate, the joint fit (the gloss estimated first
-    /// when asked).
-    fn exact(&self, method: &Method, found: &mut Found) -> Result<()> {
+    /// when asked). `gate` may end the joint fit at its start ([`JointOptions::start_gate`]);
+    /// the gloss search does not take it.
+    fn exact(&self, method: &Method, found: &mut Found, gate: Option<StartGate<'_>>) -> Result<()> {
         match method {
             Method::Joint(j) if matches!(j.gloss, GlossFit::Estimate(_)) => {
                 self.with_gloss_search(j, found)
@@ -153,7 +170,7 @@ impl Run<'_> {
                 self.paper(found)?;
                 if let Method::Joint(j) = method {
                     if !found.lights.is_empty() {
-                        self.refine(j, found)?;
+                        self.refine(j, found, gate)?;
                     }
                 }
                 Ok(())

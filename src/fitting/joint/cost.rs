@@ -66,6 +66,19 @@ impl Problem {
         m
     }
 
+    /// The expected image of the water pixels for `st`: each pixel's index into the photo
+    /// with its modelled radiance, unweighted (`scales`: the rows' weights, where they were
+    /// weighted). The direct view's pixels are left out: a light's sharp image there would
+    /// match the photo whatever the water model.
+    pub(super) fn water_image(&self, st: &State, scales: Option<&[f32]>) -> Vec<(u32, [f32; 3])> {
+        (0..self.first_direct)
+            .map(|i| {
+                let s = scales.map_or(1.0, |s| s[i]);
+                (self.pixel_ids[i], self.model(st, i).map(|c| c as f32 / s))
+            })
+            .collect()
+    }
+
     /// Residual sum of squares (clipped pixels only where the model is below them), less the
     /// coefficients' own noise (see the module doc).
     pub(super) fn cost(&self, st: &State) -> f64 {

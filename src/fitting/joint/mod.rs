@@ -61,14 +61,15 @@
 //!
 //! | file | what |
 //! |---|---|
-//! | `mod.rs` | the outcome, [`fit_joint`] |
-//! | `options` | what to fit with: samples, sweeps, pixels, splits |
+//! | `mod.rs` | [`fit_joint`] |
+//! | `options` | what to fit with: samples, sweeps, pixels, splits, a test of the start |
+//! | `outcome` | what a fit returns |
 //! | `region` | the fitted pixels, each light's region of interest |
 //! | `direct` | the pixels that see a light's wall directly, their samples |
 //! | `direct_images` | a lamp's image in the photo: the bright pixels that see its wall |
 //! | `direct_start` | starts far from a light's direct image moved onto it, fragments merged |
 //! | `lamp_starts` | one start per lamp whose reflections share a streak with another's |
-//! | `samples` | tracing and storing the plane samples, a coefficient from them |
+//! | `samples`, `trace` | the stored plane samples, a coefficient from them; their trace |
 //! | `reweight` | a search's samples from one trace, weighted for each fit's lobe |
 //! | `proposal` | the lobe that trace is drawn from, the targets it serves |
 //! | `near` | the samples a moving edge can change, found by bisection |
@@ -81,7 +82,7 @@
 //! | `pieces` | a profile's sums as polynomials over runs of its grid |
 //! | `profile` | the cost at every grid position of one edge |
 //! | `descent` | coordinate descent and its windows |
-//! | `optimise` | descent, split, boundary search, descent; repeats' replay |
+//! | `optimise` | the start state; descent, split, boundary search, descent; repeats' replay |
 //! | `split`, `boundary` | overlapping streaks: the cut, the boundary search |
 //! | `significance` | lights the photo cannot tell from nothing, dropped |
 //! | `repeats` | the mean of repeated fits and its standard error |
@@ -115,6 +116,7 @@ mod lamp_starts;
 mod near;
 mod optimise;
 mod options;
+mod outcome;
 mod pieces;
 mod problem;
 mod profile;
@@ -130,66 +132,20 @@ mod stacked;
 mod trace;
 mod uncertainty;
 
-pub use options::{JointOptions, PixelShare, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
+pub use options::{JointOptions, PixelShare, StartGate, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
+pub use outcome::JointOutcome;
 pub use proposal::{Lobe, ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
 pub use samples::effective_samples;
 pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty};
 
 use direct::direct_pixels;
-use optimise::optimise;
+use optimise::{optimise, start_state};
 use problem::{Problem, State};
 use region::{region, region_of_interest};
 use repeats::mean_and_spread;
 use samples::sample_extent;
 use uncertainty::{facing_edges, uncertainties, FACING_REASON};
-
-/// The result of a joint fit.
-#[derive(Clone, Debug)]
-pub struct JointOutcome {
-    /// The refined lights, in the order given.
-    pub lights: Vec<FittedLight>,
-    /// Their uncertainties, in the same order.
-    pub uncertainty: Vec<Uncertainty>,
-    /// Pixels in the fitted region: the water pixels and, with the direct view, those that
-    /// see a light's wall directly.
-    pub pixels: usize,
-    /// Residual sum of squares per pixel and channel at the optimum (radiance units squared).
-    pub residual_variance: f64,
-    /// The fit's cost at the optimum: the residual sum of squares less the samples' own noise
-    /// (module doc); comparable between fits of the same pixels. Not positive when the fit
-    /// has broken down (the photo's own noise keeps a sound fit's cost positive).
-    pub cost: f64,
-    /// Wall-clock seconds: "footprints" and "optimise".
-    pub timings: Vec<(String, f64)>,
-    /// The fitted water pixels (index `y * width + x` into the photo) with their modelled
-    /// radiance at the optimum, per channel: the expected image the photo was compared with
-    /// (the direct view's pixels left out).
-    pub modelled: Vec<(u32, [f32; 3])>,
-    /// Things the user should know: the lights dropped because the photo cannot tell them
-    /// from nothing (`significance`), with why.
-    pub warnings: Vec<String>,
-    /// The start lights the fit explained as two, and which way
-    /// ([`JointOptions::known_splits`] of a refit).
-    pub splits: Vec<Split>,
-    /// Per fitted pixel, the scale its row was weighted by (`glitter`), when it was.
-    pub row_scales: Option<Vec<f32>>,
-}
-
-impl JointOutcome {
-    /// The refined lights, each edge's status taken from its uncertainty ([`edge_statuses`]:
-    /// an edge the photo does not constrain is marked so).
-    pub fn lights_with_statuses(&self) -> Vec<FittedLight> {
-        self.lights
-            .iter()
-            .zip(&self.uncertainty)
-            .map(|(l, u)| FittedLight {
-                edges: edge_statuses(l, u),
-                ..l.clone()
-            })
-            .collect()
-    }
-}
 
 /// Refines `start` (typically the paper's per-streak estimate) by fitting all lights together
 /// to every water pixel of their streaks and surroundings (see the module doc).
@@ -240,18 +196,7 @@ pub fn fit_joint_with(
         ));
     }
     if start.is_empty() {
-        return Ok(JointOutcome {
-            lights: Vec::new(),
-            uncertainty: Vec::new(),
-            pixels: 0,
-            residual_variance: 0.0,
-            cost: 0.0,
-            timings: Vec::new(),
-            modelled: Vec::new(),
-            warnings: Vec::new(),
-            splits: Vec::new(),
-            row_scales: None,
-        });
+        return Ok(JointOutcome::empty());
     }
     // Starts far from the lights' direct images are moved onto them (`direct_start`).
     let moved;
@@ -385,13 +330,27 @@ pub fn fit_joint_with(
         glitter::scale_rows(&mut problem, s);
     }
     let mut footprint_seconds = t0.elapsed().as_secs_f64();
+    let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
+    if let Some(gate) = options.start_gate {
+        let mut st = start_state(&problem, start, &extents);
+        problem.solve_radiance(&mut st);
+        let modelled = problem.water_image(&st, given_scales);
+        if !(gate.0)(&modelled) {
+            return Ok(JointOutcome {
+                pixels: pixels.len(),
+                timings: vec![("footprints".into(), footprint_seconds)],
+                modelled,
+                stopped_at_start: true,
+                ..JointOutcome::empty()
+            });
+        }
+    }
     options.progress.stage(&format!(
         "joint fit: descent of {} light(s), {} sweeps",
         start.len(),
         options.sweeps
     ));
     let t1 = Instant::now();
-    let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
     let (first, replay, splits) = optimise(
         &mut problem,
         start,
@@ -510,17 +469,7 @@ pub fn fit_joint_with(
     let cost = problem.cost(&st);
     let variance = problem.residual_variance(&st);
     optimise_seconds += t2.elapsed().as_secs_f64();
-    // The water pixels alone: the direct view's sharp image of a light would match the photo
-    // whatever the water model.
-    let modelled = (0..problem.first_direct)
-        .map(|i| {
-            let s = scales.as_ref().map_or(1.0, |s| s[i]);
-            (
-                problem.pixel_ids[i],
-                problem.model(&st, i).map(|c| c as f32 / s),
-            )
-        })
-        .collect();
+    let modelled = problem.water_image(&st, scales.as_deref());
     let facing = facing_edges(&problem, &st);
     for (k, u) in uncertainty.iter_mut().enumerate() {
         u.direct_pixels = problem.direct_pixels_inside(st.set_of[k], &st.rects[k]);
@@ -578,6 +527,7 @@ pub fn fit_joint_with(
         warnings,
         splits,
         row_scales: scales,
+        stopped_at_start: false,
     })
 }
 

@@ -39,32 +39,7 @@ pub(super) fn optimise(
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     progress: Reporter<'_>,
 ) -> (State, State, Vec<Split>) {
-    let rects: Vec<Rect> = start
-        .iter()
-        .zip(extents.iter())
-        .map(|(l, e)| e.map_or(l.rect(), |e| l.rect().clamp_to(&e)))
-        .collect();
-    // An edge no streak-edge pixel looks at is held, unless the photo shows it directly.
-    let pinned = start
-        .iter()
-        .zip(&rects)
-        .enumerate()
-        .map(|(k, (l, r))| {
-            let direct = problem.direct_edge_pixels(k, r);
-            EdgeSide::ALL.map(|side| {
-                matches!(
-                    l.edges[side],
-                    EdgeStatus::Unconstrained { unseen: true, .. }
-                ) && direct[side] == 0
-            })
-        })
-        .collect();
-    let mut st = problem.state(
-        (0..start.len()).collect(),
-        pinned,
-        rects,
-        start.iter().map(|l| l.radiance.map(f64::from)).collect(),
-    );
+    let mut st = start_state(problem, start, extents);
     let mut replay = st.clone();
     problem.descend(&mut st, extents, sweeps);
     let mut splits = Vec::new();
@@ -120,6 +95,41 @@ pub(super) fn optimise(
         }
     }
     (st, replay, splits)
+}
+
+/// The state a fit starts from: the `start` lights, each inside its samples' extent, with an
+/// edge held where no streak-edge pixel looks at it and the photo does not show it directly.
+pub(super) fn start_state(
+    problem: &Problem,
+    start: &[FittedLight],
+    extents: &[Option<Rect>],
+) -> State {
+    let rects: Vec<Rect> = start
+        .iter()
+        .zip(extents.iter())
+        .map(|(l, e)| e.map_or(l.rect(), |e| l.rect().clamp_to(&e)))
+        .collect();
+    // An edge no streak-edge pixel looks at is held, unless the photo shows it directly.
+    let pinned = start
+        .iter()
+        .zip(&rects)
+        .enumerate()
+        .map(|(k, (l, r))| {
+            let direct = problem.direct_edge_pixels(k, r);
+            EdgeSide::ALL.map(|side| {
+                matches!(
+                    l.edges[side],
+                    EdgeStatus::Unconstrained { unseen: true, .. }
+                ) && direct[side] == 0
+            })
+        })
+        .collect();
+    problem.state(
+        (0..start.len()).collect(),
+        pinned,
+        rects,
+        start.iter().map(|l| l.radiance.map(f64::from)).collect(),
+    )
 }
 
 impl Problem {

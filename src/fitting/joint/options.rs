@@ -72,6 +72,27 @@ pub struct JointOptions<'a> {
     /// once for a whole search ([`Reweight`]): the fit's water model must be its target.
     /// `None` by default (every fit traces its own).
     pub reweight: Option<Reweight<'a>>,
+    /// A test of the start: called once, after the trace, with the expected image of the
+    /// water pixels at the start lights (their radiance solved in closed form, no edge moved
+    /// yet); where it returns false the fit ends there
+    /// ([`JointOutcome::stopped_at_start`](super::JointOutcome::stopped_at_start)). The
+    /// automatic choice of the water model asks it whether the scene's waves could be the
+    /// photo's at all before it spends the descent. `None` by default.
+    pub start_gate: Option<StartGate<'a>>,
+}
+
+/// A test of a joint fit's start image ([`JointOptions::start_gate`]): the water pixels'
+/// indices into the photo with their modelled radiance in; whether to go on, out.
+#[derive(Clone, Copy)]
+pub struct StartGate<'a>(pub &'a (dyn Fn(&[ModelledPixel]) -> bool + Sync));
+
+/// A fitted pixel's index `y * width + x` into the photo and its modelled radiance.
+pub type ModelledPixel = (u32, [f32; 3]);
+
+impl std::fmt::Debug for StartGate<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("StartGate")
+    }
 }
 
 impl JointOptions<'_> {
@@ -96,6 +117,7 @@ impl JointOptions<'_> {
             glitter_weights: false,
             row_scales: None,
             reweight: None,
+            start_gate: None,
         }
     }
 }

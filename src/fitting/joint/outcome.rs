@@ -1,0 +1,75 @@
+//! What a joint fit returns ([`JointOutcome`]).
+
+use super::uncertainty::{edge_statuses, Uncertainty};
+use super::Split;
+use crate::fitting::FittedLight;
+
+/// The result of a joint fit.
+#[derive(Clone, Debug)]
+pub struct JointOutcome {
+    /// The refined lights, in the order given.
+    pub lights: Vec<FittedLight>,
+    /// Their uncertainties, in the same order.
+    pub uncertainty: Vec<Uncertainty>,
+    /// Pixels in the fitted region: the water pixels and, with the direct view, those that
+    /// see a light's wall directly.
+    pub pixels: usize,
+    /// Residual sum of squares per pixel and channel at the optimum (radiance units squared).
+    pub residual_variance: f64,
+    /// The fit's cost at the optimum: the residual sum of squares less the samples' own noise
+    /// (module doc); comparable between fits of the same pixels. Not positive when the fit
+    /// has broken down (the photo's own noise keeps a sound fit's cost positive).
+    pub cost: f64,
+    /// Wall-clock seconds: "footprints" and "optimise".
+    pub timings: Vec<(String, f64)>,
+    /// The fitted water pixels (index `y * width + x` into the photo) with their modelled
+    /// radiance at the optimum, per channel: the expected image the photo was compared with
+    /// (the direct view's pixels left out).
+    pub modelled: Vec<(u32, [f32; 3])>,
+    /// Things the user should know: the lights dropped because the photo cannot tell them
+    /// from nothing (`significance`), with why.
+    pub warnings: Vec<String>,
+    /// The start lights the fit explained as two, and which way
+    /// ([`JointOptions::known_splits`](super::JointOptions::known_splits) of a refit).
+    pub splits: Vec<Split>,
+    /// Per fitted pixel, the scale its row was weighted by (`glitter`), when it was.
+    pub row_scales: Option<Vec<f32>>,
+    /// Whether the fit ended at its start, as its
+    /// [`JointOptions::start_gate`](super::JointOptions::start_gate) said: then it has no
+    /// light, and `modelled` is the start lights' expected image.
+    pub stopped_at_start: bool,
+}
+
+impl JointOutcome {
+    /// The outcome of a fit that fitted nothing.
+    pub(super) fn empty() -> Self {
+        JointOutcome {
+            lights: Vec::new(),
+            uncertainty: Vec::new(),
+            pixels: 0,
+            residual_variance: 0.0,
+            cost: 0.0,
+            timings: Vec::new(),
+            modelled: Vec::new(),
+            warnings: Vec::new(),
+            splits: Vec::new(),
+            row_scales: None,
+            stopped_at_start: false,
+        }
+    }
+}
+
+impl JointOutcome {
+    /// The refined lights, each edge's status taken from its uncertainty ([`edge_statuses`]:
+    /// an edge the photo does not constrain is marked so).
+    pub fn lights_with_statuses(&self) -> Vec<FittedLight> {
+        self.lights
+            .iter()
+            .zip(&self.uncertainty)
+            .map(|(l, u)| FittedLight {
+                edges: edge_statuses(l, u),
+                ..l.clone()
+            })
+            .collect()
+    }
+}
