@@ -8,7 +8,7 @@ use super::water_choice::{
 };
 use super::{Found, GlossFit, Method, Run, EXACT_MIN_CORRELATION};
 use crate::fitting::gloss::GlossSearch;
-use crate::fitting::joint::{JointOptions, StartGate};
+use crate::fitting::joint::{JointOptions, ModelledPixel, StartGate};
 use crate::fitting::slopes::{estimate_slopes, water_with_total, MICROFACET_GLOSS};
 use crate::fitting::{self, FitOptions};
 use crate::optics::{GaussianSlopes, ReflectionModel};
@@ -91,7 +91,7 @@ impl Run<'_> {
                 // Where the start lights' expected image already shows fine structure
                 // unrelated to the photo's, the fit ends there (`clearly_not_exact`).
                 let photo = self.photo;
-                let gate = |modelled: &[(u32, [f32; 3])]| {
+                let gate = |modelled: &[ModelledPixel]| {
                     !fine_structure(&photo.radiance, photo.width, modelled)
                         .is_some_and(|f| f.clearly_not_exact())
                 };

@@ -21,6 +21,7 @@
 //! cost up to a constant, and its normal equations carry `c_a c_b - d_a d_b`.
 
 use super::problem::{Problem, State};
+use super::ModelledPixel;
 use crate::fitting::linalg::nnls_normal;
 use crate::fitting::rect::Rect;
 
@@ -70,7 +71,7 @@ impl Problem {
     /// with its modelled radiance, unweighted (`scales`: the rows' weights, where they were
     /// weighted). The direct view's pixels are left out: a light's sharp image there would
     /// match the photo whatever the water model.
-    pub(super) fn water_image(&self, st: &State, scales: Option<&[f32]>) -> Vec<(u32, [f32; 3])> {
+    pub(super) fn water_image(&self, st: &State, scales: Option<&[f32]>) -> Vec<ModelledPixel> {
         (0..self.first_direct)
             .map(|i| {
                 let s = scales.map_or(1.0, |s| s[i]);

@@ -132,7 +132,9 @@ mod stacked;
 mod trace;
 mod uncertainty;
 
-pub use options::{JointOptions, PixelShare, StartGate, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES};
+pub use options::{
+    JointOptions, ModelledPixel, PixelShare, StartGate, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES,
+};
 pub use outcome::JointOutcome;
 pub use proposal::{Lobe, ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
 pub use samples::effective_samples;

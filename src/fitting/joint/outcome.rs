@@ -1,7 +1,7 @@
 //! What a joint fit returns ([`JointOutcome`]).
 
 use super::uncertainty::{edge_statuses, Uncertainty};
-use super::Split;
+use super::{ModelledPixel, Split};
 use crate::fitting::FittedLight;
 
 /// The result of a joint fit.
@@ -25,7 +25,7 @@ pub struct JointOutcome {
     /// The fitted water pixels (index `y * width + x` into the photo) with their modelled
     /// radiance at the optimum, per channel: the expected image the photo was compared with
     /// (the direct view's pixels left out).
-    pub modelled: Vec<(u32, [f32; 3])>,
+    pub modelled: Vec<ModelledPixel>,
     /// Things the user should know: the lights dropped because the photo cannot tell them
     /// from nothing (`significance`), with why.
     pub warnings: Vec<String>,
@@ -57,9 +57,7 @@ impl JointOutcome {
             stopped_at_start: false,
         }
     }
-}
 
-impl JointOutcome {
     /// The refined lights, each edge's status taken from its uncertainty ([`edge_statuses`]:
     /// an edge the photo does not constrain is marked so).
     pub fn lights_with_statuses(&self) -> Vec<FittedLight> {
