@@ -492,7 +492,8 @@ impl Curve for &mut Cost<'_> {
     fn point(&mut self, x: f64) -> Result<Point> {
         let gloss = x.exp() as f32;
         self.fit.progress.stage(&format!(
-            "gloss search: joint fit {} of at most {}, at e = {gloss:.0}",
+            "gloss search: joint fit {} at e = {gloss:.0} (at most {} glosses, besides those \
+             fitted again on a new trace)",
             self.evaluations.len() + 1,
             self.options.max_evaluations
         ));
