@@ -112,6 +112,33 @@ fn other_waves_take_the_statistical_model() {
     assert_pair(&scene, &lit);
 }
 
+/// With the gloss searched as well (`--gloss auto`), the search's first fit already finds
+/// the other waves unrelated to the photo: no gloss search is made over them, and the
+/// statistical fit gives the pair as without it.
+#[test]
+fn other_waves_end_a_gloss_search_at_its_first_fit() {
+    use streaklight::pipeline::{JointSettings, Method};
+    let scene = sample_scene("harbour-other-waves.gltf", None);
+    let photo = sample_photo("harbour-pair.png");
+    let settings = FitSettings {
+        method: Method::Joint(JointSettings::estimating_gloss()),
+        ..FitSettings::default()
+    };
+    let lit = pipeline::fit(&scene, &photo, &settings, Reporter::default()).unwrap();
+    let used = &lit.water_model;
+    assert_eq!(
+        (used.model, used.chosen),
+        ("statistical", "detected"),
+        "{used:?}"
+    );
+    assert!(
+        used.reason.contains("the exact fit was not made"),
+        "{}",
+        used.reason
+    );
+    assert_pair(&scene, &lit);
+}
+
 /// The slope variances of a lobe known exactly. The photo is the statistical model's expected
 /// image of the pair over the harbour's flat quad with total slope variances of 3.3e-3 along
 /// the view and 2.0e-3 across (the harbour chop's over the water the lights' reflections

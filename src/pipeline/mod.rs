@@ -432,8 +432,14 @@ impl Run<'_> {
         self.joint(water_model, start, &refit, "joint refit of overlaps", found)
     }
 
-    /// The joint fit with the gloss estimated first ([`GlossFit::Estimate`]).
-    fn with_gloss_search(&self, j: &JointSettings, found: &mut Found) -> Result<()> {
+    /// The joint fit with the gloss estimated first ([`GlossFit::Estimate`]); `gate` may end
+    /// the search at its first fit ([`JointOptions::start_gate`]).
+    fn with_gloss_search(
+        &self,
+        j: &JointSettings,
+        found: &mut Found,
+        gate: Option<StartGate<'_>>,
+    ) -> Result<()> {
         let GlossFit::Estimate(search) = &j.gloss else {
             return Ok(());
         };
@@ -448,9 +454,20 @@ impl Run<'_> {
             self.water,
             self.observations,
             &self.paper,
-            &final_fit,
+            &JointOptions {
+                start_gate: gate,
+                ..final_fit
+            },
             search,
         )?;
+        if estimate.stopped_at_start {
+            found.skipped = estimate.skipped;
+            found.warnings.extend(estimate.warnings);
+            found.timings = estimate.timings;
+            found.modelled = estimate.modelled;
+            found.stopped_at_start = true;
+            return Ok(());
+        }
         found.gloss = (
             estimate.gloss,
             format!(

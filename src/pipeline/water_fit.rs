@@ -159,12 +159,12 @@ impl Run<'_> {
     }
 
     /// The exact model's fit: the paper's estimate, the joint fit (the gloss estimated first
-    /// when asked). `gate` may end the joint fit at its start ([`JointOptions::start_gate`]);
-    /// the gloss search does not take it.
+    /// when asked). `gate` may end the joint fit at its start ([`JointOptions::start_gate`]),
+    /// or the gloss search at its first fit.
     fn exact(&self, method: &Method, found: &mut Found, gate: Option<StartGate<'_>>) -> Result<()> {
         match method {
             Method::Joint(j) if matches!(j.gloss, GlossFit::Estimate(_)) => {
-                self.with_gloss_search(j, found)
+                self.with_gloss_search(j, found, gate)
             }
             method => {
                 self.paper(found)?;

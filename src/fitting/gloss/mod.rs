@@ -100,14 +100,16 @@ pub(super) mod search;
 use std::time::Instant;
 
 use super::joint::{
-    fit_joint, JointOptions, Lobe, PixelShare, ProposalCache, Reweight, Split, Uncertainty,
+    fit_joint, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache, Reweight, Split,
+    StartGate, Uncertainty,
 };
-use super::{fit_paper, EdgeStatus, FitOptions, FittedLight, Skipped, StreakObservation};
+use super::{fit_paper, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::{Error, Result};
+pub(super) use search::search_start;
 use search::{search, Curve, Point, Stop};
 
 /// How to search for the gloss. What the fits themselves read (samples, pixels, repeats,
@@ -235,10 +237,14 @@ pub struct GlossEstimate {
     pub timings: Vec<(String, f64)>,
     /// The final joint fit's expected image: its fitted water pixels with their modelled
     /// radiance ([`super::joint::JointOutcome::modelled`]).
-    pub modelled: Vec<(u32, [f32; 3])>,
+    pub modelled: Vec<ModelledPixel>,
     /// The start lights the final fit explained as two
     /// ([`super::joint::JointOutcome::splits`]).
     pub splits: Vec<Split>,
+    /// Whether the search ended at its first fit, whose start gate
+    /// ([`JointOptions::start_gate`] of the final fit's options) said so: then there is no
+    /// estimate and no light, and `modelled` is that fit's start image.
+    pub stopped_at_start: bool,
 }
 
 /// Estimates the water's gloss from the photo and fits the lights with it (see the module
@@ -309,6 +315,8 @@ pub fn estimate_gloss(
         proposal: ProposalCache::new(proposal(x0)),
         evaluations: Vec::new(),
         failed: Vec::new(),
+        gate: final_fit.start_gate,
+        stopped: None,
     };
     let found = search(
         options,
@@ -319,10 +327,31 @@ pub fn estimate_gloss(
     )?;
     // The kept trace is freed before the final fit traces its own: the peak memory is the
     // larger of the two, not their sum.
-    let (evaluations, failed) = {
+    let (evaluations, failed, stopped) = {
         let done = cost;
-        (done.evaluations, done.failed)
+        (done.evaluations, done.failed, done.stopped)
     };
+    if let Some(modelled) = stopped {
+        timings.push((
+            "search (stopped at its first fit)".into(),
+            t.elapsed().as_secs_f64(),
+        ));
+        return Ok(GlossEstimate {
+            gloss: start_options.model.gloss,
+            sigma_ln: None,
+            evaluations: Vec::new(),
+            lights: Vec::new(),
+            uncertainty: Vec::new(),
+            residual_variance: 0.0,
+            start: paper.lights,
+            skipped: paper.skipped,
+            warnings,
+            timings,
+            modelled,
+            splits: Vec::new(),
+            stopped_at_start: true,
+        });
+    }
     timings.push((
         format!("search ({} evaluations)", evaluations.len()),
         t.elapsed().as_secs_f64(),
@@ -334,7 +363,7 @@ pub fn estimate_gloss(
         ));
     }
     match found.stop {
-        Stop::Converged => {}
+        Stop::Converged | Stop::Abandoned => {}
         Stop::AtLimit => warnings.push(format!(
             "the gloss estimate lies at the search's limit ({gloss:.0}, searched {} to {}): \
              the photo fits best with a gloss at or beyond it",
@@ -363,6 +392,8 @@ pub fn estimate_gloss(
                 gloss,
                 ..final_fit.model
             },
+            // The gate was the search's first fit's to ask.
+            start_gate: None,
             ..*final_fit
         },
     )?;
@@ -385,54 +416,8 @@ pub fn estimate_gloss(
         timings,
         modelled: final_fit.modelled,
         splits: final_fit.splits,
+        stopped_at_start: false,
     })
-}
-
-/// The start of a search over the water's lobe from the paper fit `paper` of `streaks`
-/// streaks: its lights with every edge free to move (the paper fit places an edge it found
-/// no pixel for at the lobes' farthest reach, and the joint fit would hold it there; under
-/// another lobe that reach is another). Fails when the paper fit found no light (`what` is
-/// the parameter that then cannot be estimated).
-pub(super) fn search_start(
-    paper: &super::FitOutcome,
-    streaks: usize,
-    what: &str,
-) -> Result<Vec<FittedLight>> {
-    if paper.lights.is_empty() {
-        return Err(Error::NothingFound(format!(
-            "{streaks} streak(s) found but no light could be fitted, so the {what} cannot be \
-             estimated: {}",
-            paper
-                .skipped
-                .iter()
-                .map(skipped_message)
-                .collect::<Vec<_>>()
-                .join("; ")
-        )));
-    }
-    Ok(paper
-        .lights
-        .iter()
-        .map(|l| FittedLight {
-            edges: l.edges.clone().map(|e| match e {
-                EdgeStatus::Unconstrained { reason, pixels, .. } => EdgeStatus::Unconstrained {
-                    reason,
-                    pixels,
-                    unseen: false,
-                },
-                constrained => constrained,
-            }),
-            ..l.clone()
-        })
-        .collect())
-}
-
-fn skipped_message(s: &Skipped) -> String {
-    match s {
-        Skipped::NoPlane { streak, message } | Skipped::NoSolution { streak, message } => {
-            format!("streak {streak}: {message}")
-        }
-    }
 }
 
 /// What the search's fits share: the start's model (the gloss varies), the seed, and whom
@@ -485,6 +470,10 @@ struct Cost<'a> {
     evaluations: Vec<(f64, f64)>,
     /// Evaluations whose fit broke down (module doc), for a warning.
     failed: Vec<f32>,
+    /// The first fit's start gate (the final fit's [`JointOptions::start_gate`]).
+    gate: Option<StartGate<'a>>,
+    /// The first fit's start image, where its gate ended it.
+    stopped: Option<Vec<ModelledPixel>>,
 }
 
 impl Curve for &mut Cost<'_> {
@@ -516,6 +505,7 @@ impl Curve for &mut Cost<'_> {
                     cache: &self.proposal,
                     target: Lobe::Exact { gloss },
                 }),
+                start_gate: self.gate.filter(|_| self.evaluations.is_empty()),
                 ..JointOptions::new(
                     ReflectionModel {
                         gloss,
@@ -525,6 +515,14 @@ impl Curve for &mut Cost<'_> {
                 )
             },
         )?;
+        if fit.stopped_at_start {
+            self.stopped = Some(fit.modelled);
+            return Ok(Point {
+                x,
+                s: f64::INFINITY,
+                variance: 0.0,
+            });
+        }
         let mut s = fit.cost;
         // The residuals hold the photo's own noise, so a cost that is not positive is the fit
         // exploiting its coefficients' noise (module doc): no evidence for this gloss.
@@ -538,6 +536,10 @@ impl Curve for &mut Cost<'_> {
             s,
             variance: fit.residual_variance,
         })
+    }
+
+    fn abandoned(&self) -> bool {
+        self.stopped.is_some()
     }
 
     /// Whether the kept trace serves gloss `exp(x)`.

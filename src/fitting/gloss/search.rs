@@ -2,6 +2,7 @@
 //! by parabolas (the gloss module's doc, "Search" and "Uncertainty").
 
 use super::GlossSearch;
+use crate::fitting::{EdgeStatus, FittedLight, Skipped};
 use crate::{Error, Result};
 
 /// A point of the cost curve: `x = ln e`, its cost and residual variance.
@@ -17,6 +18,8 @@ pub(in crate::fitting) enum Stop {
     Converged,
     AtLimit,
     OutOfEvaluations,
+    /// The curve said to stop at its first point ([`Curve::abandoned`]).
+    Abandoned,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -42,6 +45,12 @@ pub(in crate::fitting) trait Curve {
     /// either side of `best` ([`GlossSearch::first_step_ln`]); the search then makes again
     /// the points it has that the new basis serves.
     fn rebase(&mut self, _next: f64, _best: f64) {}
+
+    /// Whether the search should end without an estimate: the gloss search's first fit can
+    /// find the exact model unrelated to the photo (`JointOptions::start_gate`).
+    fn abandoned(&self) -> bool {
+        false
+    }
 }
 
 impl<F: FnMut(f64) -> Result<Point>> Curve for F {
@@ -75,6 +84,13 @@ pub(in crate::fitting) fn search(
     let mut pts = Vec::new();
     for x in [centre - h0, centre, centre + h0] {
         pts.push(cost.point(x)?);
+        if cost.abandoned() {
+            return Ok(Found {
+                x,
+                sigma_ln: None,
+                stop: Stop::Abandoned,
+            });
+        }
     }
     // Points made at new places (not made again on a new basis).
     let mut made = pts.len();
@@ -221,6 +237,53 @@ fn parabola(p: &[Point; 3]) -> Option<(f64, f64)> {
     // S = a.s + d1 (x - a.x) + k (x - a.x)(x - b.x); dS/dx = 0 at:
     let v = 0.5 * (a.x + b.x) - d1 / (2.0 * k);
     v.is_finite().then_some((v, k))
+}
+
+/// The start of a search over the water's lobe from the paper fit `paper` of `streaks`
+/// streaks: its lights with every edge free to move (the paper fit places an edge it found
+/// no pixel for at the lobes' farthest reach, and the joint fit would hold it there; under
+/// another lobe that reach is another). Fails when the paper fit found no light (`what` is
+/// the parameter that then cannot be estimated).
+pub(in crate::fitting) fn search_start(
+    paper: &crate::fitting::FitOutcome,
+    streaks: usize,
+    what: &str,
+) -> Result<Vec<FittedLight>> {
+    if paper.lights.is_empty() {
+        return Err(Error::NothingFound(format!(
+            "{streaks} streak(s) found but no light could be fitted, so the {what} cannot be \
+             estimated: {}",
+            paper
+                .skipped
+                .iter()
+                .map(skipped_message)
+                .collect::<Vec<_>>()
+                .join("; ")
+        )));
+    }
+    Ok(paper
+        .lights
+        .iter()
+        .map(|l| FittedLight {
+            edges: l.edges.clone().map(|e| match e {
+                EdgeStatus::Unconstrained { reason, pixels, .. } => EdgeStatus::Unconstrained {
+                    reason,
+                    pixels,
+                    unseen: false,
+                },
+                constrained => constrained,
+            }),
+            ..l.clone()
+        })
+        .collect())
+}
+
+fn skipped_message(s: &Skipped) -> String {
+    match s {
+        Skipped::NoPlane { streak, message } | Skipped::NoSolution { streak, message } => {
+            format!("streak {streak}: {message}")
+        }
+    }
 }
 
 #[cfg(test)]
@@ -393,5 +456,40 @@ mod tests {
             assert!(curve.bases >= 1, "truth {truth}: never moved");
             assert!(found.sigma_ln.is_some_and(|s| s > 0.0));
         }
+    }
+
+    /// A curve that says to stop after its first point ends the search there, with no
+    /// estimate; one that never does is searched to its minimum as before.
+    #[test]
+    fn an_abandoned_curve_ends_the_search_at_its_first_point() {
+        struct Gated {
+            xs: Vec<f64>,
+            stop: bool,
+        }
+        impl Curve for &mut Gated {
+            fn point(&mut self, x: f64) -> Result<Point> {
+                self.xs.push(x);
+                Ok(pt(x, skewed(x, 300.0)))
+            }
+            fn abandoned(&self) -> bool {
+                self.stop && !self.xs.is_empty()
+            }
+        }
+        let range = (50f64.ln(), 5000f64.ln());
+        let mut gated = Gated {
+            xs: Vec::new(),
+            stop: true,
+        };
+        let found = search(&options(), 500f64.ln(), range, GLOSS, &mut gated).unwrap();
+        assert_eq!(found.stop, Stop::Abandoned);
+        assert_eq!(gated.xs.len(), 1);
+        assert_eq!(found.sigma_ln, None);
+        let mut open = Gated {
+            xs: Vec::new(),
+            stop: false,
+        };
+        let found = search(&options(), 500f64.ln(), range, GLOSS, &mut open).unwrap();
+        assert_eq!(found.stop, Stop::Converged);
+        assert!((found.x.exp() / 300.0 - 1.0).abs() < 0.05, "{found:?}");
     }
 }

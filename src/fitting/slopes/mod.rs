@@ -309,7 +309,8 @@ pub fn estimate_slopes(
         }
         sigma_ln[axis] = found.sigma_ln.map(|s| s as f32);
         match found.stop {
-            Stop::Converged => {}
+            // Its fits take no start gate: never abandoned.
+            Stop::Converged | Stop::Abandoned => {}
             Stop::AtLimit => warnings.push(format!(
                 "the {name} lies at the search's limit ({:.2e}, searched {lo:.0e} to {hi:.0e})",
                 variance[axis]
