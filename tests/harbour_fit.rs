@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::pipeline::{sample_photo, sample_scene};
+use common::pipeline::{observations, sample_photo, sample_scene, water};
 use streaklight::fitting::slopes::{water_with_total, MICROFACET_GLOSS};
 use streaklight::fitting::FittedLight;
 use streaklight::photo_in::Photo;
@@ -86,13 +86,11 @@ fn the_photos_own_waves_keep_the_exact_model() {
     assert_pair(&scene, &lit);
 }
 
-/// The pair over the other waves with `settings`: the statistical model, detected so far
-/// from the photo already at the paper's lights that the exact fit is not made, and the
-/// pair's lights within their bounds.
-fn other_waves_at_once(settings: &FitSettings) -> Lit {
+#[test]
+fn other_waves_take_the_statistical_model() {
     let scene = sample_scene("harbour-other-waves.gltf", None);
     let photo = sample_photo("harbour-pair.png");
-    let lit = pipeline::fit(&scene, &photo, settings, Reporter::default()).unwrap();
+    let lit = pipeline::fit(&scene, &photo, &FitSettings::default(), Reporter::default()).unwrap();
     let used = &lit.water_model;
     assert_eq!(
         (used.model, used.chosen),
@@ -100,36 +98,63 @@ fn other_waves_at_once(settings: &FitSettings) -> Lit {
         "{used:?}"
     );
     assert!(
-        used.reason.contains("the exact fit was not made"),
-        "{}",
-        used.reason
-    );
-    assert_pair(&scene, &lit);
-    lit
-}
-
-#[test]
-fn other_waves_take_the_statistical_model() {
-    let lit = other_waves_at_once(&FitSettings::default());
-    let used = &lit.water_model;
-    assert!(
         used.fine_structure_correlation.unwrap() < 0.2,
         "{}",
         used.reason
     );
+    // So far from the photo already at the paper's lights that the exact fit is not made.
+    assert!(
+        used.reason.contains("the exact fit was not made"),
+        "{}",
+        used.reason
+    );
     assert!(used.slopes.as_ref().unwrap().estimated);
+    assert_pair(&scene, &lit);
 }
 
-/// With the gloss searched as well (`--gloss auto`), the search's first fit already finds
-/// the other waves unrelated to the photo: no gloss search is made over them, and the
-/// statistical fit gives the pair as without it.
+/// With the gloss searched as well (`--gloss auto`), the exact model's gloss search takes
+/// the automatic choice's start gate at its first fit: over the other waves it ends there,
+/// asked once, with no estimate and no light, its start image unrelated to the photo (the
+/// statistical fit that follows is `other_waves_take_the_statistical_model`'s).
 #[test]
 fn other_waves_end_a_gloss_search_at_its_first_fit() {
-    use streaklight::pipeline::{JointSettings, Method};
-    other_waves_at_once(&FitSettings {
-        method: Method::Joint(JointSettings::estimating_gloss()),
-        ..FitSettings::default()
-    });
+    use streaklight::fitting::gloss::{estimate_gloss, GlossSearch};
+    use streaklight::fitting::joint::{JointOptions, ModelledPixel, StartGate};
+    use streaklight::fitting::FitOptions;
+    use streaklight::optics::ReflectionModel;
+    use streaklight::pipeline::fine_structure;
+    let scene = sample_scene("harbour-other-waves.gltf", None);
+    let photo = sample_photo("harbour-pair.png");
+    let water = water(&scene, &photo);
+    let observations = observations(&photo, &water);
+    let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let gate = |image: &[ModelledPixel]| {
+        asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        !fine_structure(&photo.radiance, photo.width, image).is_some_and(|f| f.clearly_not_exact())
+    };
+    let estimate = estimate_gloss(
+        &scene,
+        &photo,
+        &water,
+        &observations,
+        &FitOptions {
+            samples: 256,
+            seed: 1,
+            model,
+        },
+        &JointOptions {
+            start_gate: Some(StartGate(&gate)),
+            ..JointOptions::new(model, 1)
+        },
+        &GlossSearch::default(),
+    )
+    .unwrap();
+    assert!(estimate.stopped_at_start);
+    assert_eq!(asked.into_inner(), 1);
+    assert!(estimate.lights.is_empty() && estimate.evaluations.is_empty());
+    let start = fine_structure(&photo.radiance, photo.width, &estimate.modelled).unwrap();
+    assert!(start.correlation.unwrap().abs() < 0.15, "{start:?}");
 }
 
 /// The slope variances of a lobe known exactly. The photo is the statistical model's expected
