@@ -86,11 +86,29 @@ fn the_photos_own_waves_keep_the_exact_model() {
     assert_pair(&scene, &lit);
 }
 
+/// Both lamps are in the photo, so the slope search's fits after its first hold them where
+/// that fit put them, and the final fit tries neither as two lights: each is one lamp's image.
 #[test]
 fn other_waves_take_the_statistical_model() {
     let scene = sample_scene("harbour-other-waves.gltf", None);
     let photo = sample_photo("harbour-pair.png");
-    let lit = pipeline::fit(&scene, &photo, &FitSettings::default(), Reporter::default()).unwrap();
+    let stages = std::sync::Mutex::new(Vec::new());
+    let record = |line: &str| stages.lock().unwrap().push(line.to_string());
+    let lit = pipeline::fit(
+        &scene,
+        &photo,
+        &FitSettings::default(),
+        Reporter::new(&record),
+    )
+    .unwrap();
+    let stages = stages.into_inner().unwrap();
+    assert!(
+        stages
+            .iter()
+            .any(|s| s.contains("2 light(s) seen whole in the photo held")),
+        "{stages:#?}"
+    );
+    assert!(!stages.iter().any(|s| s.contains("as two")), "{stages:#?}");
     let used = &lit.water_model;
     assert_eq!(
         (used.model, used.chosen),

@@ -720,3 +720,67 @@ fn a_start_gate_ends_the_fit_before_its_descent() {
     eprintln!("explained: start {at_start:.3}, fitted {fitted:.3}");
     assert!(at_start < fitted, "start {at_start}, fitted {fitted}");
 }
+
+/// Table 1's light is in the photo, every edge crossed by pixels that see it: the fit reports
+/// it seen whole, at its fitted rectangle; with the direct view off it is not. Its image
+/// clips, next to a black wall, so each edge lies within a pixel's footprint on the wall:
+/// 10 m x 2 tan(30 deg) / 600 = 1.92 cm at the wall's nearest point, up to 16 % more at the
+/// light's far corner (the wall seen 22 degrees off the axis), and every edge's sigma is
+/// bounded by that footprint over sqrt(3) (measured: 1.13-1.14 cm). Held at a rectangle 10 cm
+/// higher (5 pixels at 10 m), a fit keeps that rectangle to the last digit, solves only the
+/// radiance, and costs more than the free fit (the photo shows the lamp lower); its top and
+/// bottom edges are not bounded by the image then (moved down a footprint, each agrees with
+/// the photo better). `held` of another length than the start lights is not used.
+#[test]
+fn a_light_seen_whole_is_reported_and_can_be_held() {
+    let start = paper_start("table1.png");
+    let fit = |held: &[Option<streaklight::fitting::Rect>], direct_view: bool| {
+        start.fit(|o| JointOptions {
+            samples: 32,
+            held,
+            direct_view,
+            ..o
+        })
+    };
+    let free = fit(&[], true);
+    assert_eq!(free.lights.len(), 1);
+    let r = free.lights[0].rect();
+    assert_eq!(free.seen_whole, vec![Some(r)]);
+    assert_eq!(fit(&[], false).seen_whole, vec![None]);
+    let footprint = 10.0 * 2.0 * 30f32.to_radians().tan() / 600.0;
+    let u = &free.uncertainty[0];
+    for side in streaklight::fitting::EdgeSide::ALL {
+        let bound = u.image_bound[side].expect("bounded by the image");
+        assert!(
+            bound >= footprint / 3f32.sqrt() && bound <= 1.16 * footprint / 3f32.sqrt(),
+            "{side:?}: {bound}"
+        );
+        assert!(u.edges[side].unwrap() <= bound, "{u:?}");
+    }
+
+    let higher = streaklight::fitting::Rect {
+        v_min: r.v_min + 0.1,
+        v_max: r.v_max + 0.1,
+        ..r
+    };
+    let held = fit(&[Some(higher)], true);
+    assert_eq!(held.lights.len(), 1);
+    assert_eq!(held.lights[0].rect(), higher);
+    let bound = held.uncertainty[0].image_bound;
+    assert_eq!(
+        (
+            bound[streaklight::fitting::EdgeSide::Top],
+            bound[streaklight::fitting::EdgeSide::Bottom]
+        ),
+        (None, None),
+        "{bound:?}"
+    );
+    assert!(
+        held.cost > free.cost,
+        "held {} against free {}",
+        held.cost,
+        free.cost
+    );
+    let ignored = fit(&[Some(higher), None], true);
+    assert_eq!(ignored.lights, free.lights);
+}

@@ -103,7 +103,7 @@ use super::joint::{
     fit_joint, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache, Reweight, Split,
     StartGate, Uncertainty,
 };
-use super::{fit_paper, FitOptions, FittedLight, Skipped, StreakObservation};
+use super::{fit_paper, FitOptions, FittedLight, Rect, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::progress::Reporter;
@@ -317,6 +317,7 @@ pub fn estimate_gloss(
         failed: Vec::new(),
         gate: final_fit.start_gate,
         stopped: None,
+        held: None,
     };
     let found = search(
         options,
@@ -474,6 +475,10 @@ struct Cost<'a> {
     gate: Option<StartGate<'a>>,
     /// The first fit's start image, where its gate ended it.
     stopped: Option<Vec<ModelledPixel>>,
+    /// The lights the first fit on the current trace saw whole in the photo, by start light
+    /// ([`super::joint::JointOutcome::seen_whole`]): every later fit on it holds them there,
+    /// their images pinning them whatever the gloss (module doc).
+    held: Option<Vec<Option<Rect>>>,
 }
 
 impl Curve for &mut Cost<'_> {
@@ -506,6 +511,7 @@ impl Curve for &mut Cost<'_> {
                     target: Lobe::Exact { gloss },
                 }),
                 start_gate: self.gate.filter(|_| self.evaluations.is_empty()),
+                held: self.held.as_deref().unwrap_or(&[]),
                 ..JointOptions::new(
                     ReflectionModel {
                         gloss,
@@ -522,6 +528,16 @@ impl Curve for &mut Cost<'_> {
                 s: f64::INFINITY,
                 variance: 0.0,
             });
+        }
+        if self.held.is_none() {
+            let seen = fit.seen_whole.iter().filter(|r| r.is_some()).count();
+            if seen > 0 {
+                self.fit.progress.stage(&format!(
+                    "gloss search: {seen} light(s) seen whole in the photo held where this fit \
+                     put them"
+                ));
+            }
+            self.held = Some(fit.seen_whole);
         }
         let mut s = fit.cost;
         // The residuals hold the photo's own noise, so a cost that is not positive is the fit
@@ -553,6 +569,8 @@ impl Curve for &mut Cost<'_> {
     /// [`PROPOSAL_BROADER`].
     fn rebase(&mut self, next: f64, best: f64) {
         self.proposal = ProposalCache::new(proposal(next.min(best)));
+        // The first fit on the new trace, nearer the estimate, places the held lights again.
+        self.held = None;
     }
 }
 

@@ -105,19 +105,18 @@ impl Problem {
                 let m = self.model(st, i);
                 (0..3)
                     .map(|c| {
-                        let r = self.obs[i][c] as f64 - m[c];
-                        if self.clipped_channels[i][c] && r < 0.0 {
-                            0.0
-                        } else if remove_noise {
-                            let d: f64 = st
-                                .radiance
-                                .iter()
-                                .enumerate()
-                                .map(|(k, l)| l[c] * st.dev[k][i] as f64)
-                                .sum();
-                            r * r - d * d
-                        } else {
-                            r * r
+                        match squared_residual(self.obs[i][c], m[c], self.clipped_channels[i][c]) {
+                            None => 0.0,
+                            Some(squared) if remove_noise => {
+                                let d: f64 = st
+                                    .radiance
+                                    .iter()
+                                    .enumerate()
+                                    .map(|(k, l)| l[c] * st.dev[k][i] as f64)
+                                    .sum();
+                                squared - d * d
+                            }
+                            Some(squared) => squared,
                         }
                     })
                     .sum::<f64>()
@@ -219,4 +218,11 @@ impl Problem {
         }
         (rest, rest_dev)
     }
+}
+
+/// A channel's squared residual, the photo's value `obs` against the `model`, or `None` for a
+/// channel the photo clipped (`clipped`: a lower bound) that the model does not fall below.
+pub(super) fn squared_residual(obs: f32, model: f64, clipped: bool) -> Option<f64> {
+    let r = obs as f64 - model;
+    (!(clipped && r < 0.0)).then_some(r * r)
 }

@@ -111,6 +111,7 @@ pub(crate) mod direct_start;
 #[cfg(test)]
 mod fixture;
 mod glitter;
+mod image_bound;
 mod kernel;
 mod lamp_starts;
 mod near;
@@ -334,7 +335,7 @@ pub fn fit_joint_with(
     let mut footprint_seconds = t0.elapsed().as_secs_f64();
     let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
     if let Some(gate) = options.start_gate {
-        let mut st = start_state(&problem, start, &extents);
+        let mut st = start_state(&problem, start, &extents, options.held);
         problem.solve_radiance(&mut st);
         let modelled = problem.water_image(&st, given_scales);
         if !(gate.0)(&modelled) {
@@ -362,6 +363,7 @@ pub fn fit_joint_with(
         options.known_splits,
         &|origin, draw| fresh_set(0, origin, draw),
         options.progress,
+        options.held,
     );
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
@@ -473,6 +475,17 @@ pub fn fit_joint_with(
     optimise_seconds += t2.elapsed().as_secs_f64();
     let modelled = problem.water_image(&st, scales.as_deref());
     let facing = facing_edges(&problem, &st);
+    // By start light: the rectangle of each whose every edge its direct image pins within a
+    // pixel's footprint (`image_bound`), unless a split made two lights of it.
+    let mut seen_whole: Vec<Option<Rect>> = vec![None; start.len()];
+    for (k, u) in uncertainty.iter().enumerate() {
+        let origin = problem.set_origin[st.set_of[k]];
+        let alone =
+            (0..st.rects.len()).all(|j| j == k || problem.set_origin[st.set_of[j]] != origin);
+        if alone && u.image_bound.iter().all(Option::is_some) {
+            seen_whole[origin] = Some(st.rects[k]);
+        }
+    }
     for (k, u) in uncertainty.iter_mut().enumerate() {
         u.direct_pixels = problem.direct_pixels_inside(st.set_of[k], &st.rects[k]);
         u.radiance_seen = problem.sees_radiance(st.set_of[k], &st.rects[k], st.radiance[k]);
@@ -530,6 +543,7 @@ pub fn fit_joint_with(
         splits,
         row_scales: scales,
         stopped_at_start: false,
+        seen_whole,
     })
 }
 
@@ -547,6 +561,7 @@ fn finish(
     for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
         u.edges = EdgeSide::ALL.map(|e| u.edges[e].map(|sd| sd.hypot(edges[e as usize])));
         u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
+        u.bound_by_image();
     }
     uncertainty
 }

@@ -4,7 +4,11 @@
 //! Overlapping streaks (two lights whose reflections merge into one region, the paper's
 //! §5.3): when the residual of a fit is structured along the image rows
 //! ([`Problem::structured`]), each light is tried as two, one above the other or side by side
-//! ([`try_split`]), and the split is kept when it removes most of that structure. The second
+//! ([`try_split`]), and the split is kept when it removes most of that structure. A light the
+//! photo shows whole (every edge pinned by its direct image within a pixel's footprint:
+//! [`Problem::image_bound`]) is not tried: it is one lamp's image, whose direct pixels refuse a cut in half, and under the statistical
+//! model, whose residual is the glitter and always structured, its trials were most of the
+//! final fit's time. The second
 //! light of a split then reads a sample set of its own, drawn independently on the same
 //! plane, and the boundary between the two is searched globally ([`search_boundary`]) before
 //! the final descent. A repeat on other samples ([`Problem::replay`]) starts from where the
@@ -38,13 +42,35 @@ pub(super) fn optimise(
     known: &[Split],
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     progress: Reporter<'_>,
+    held: &[Option<Rect>],
 ) -> (State, State, Vec<Split>) {
-    let mut st = start_state(problem, start, extents);
+    let mut st = start_state(problem, start, extents, held);
     let mut replay = st.clone();
     problem.descend(&mut st, extents, sweeps);
     let mut splits = Vec::new();
-    if split && problem.structured(&st) {
-        for k in 0..start.len() {
+    // A light whose every edge its direct image pins (`image_bound`) is one lamp's image:
+    // its reflections need no second light (lamps with images of their own start lights of
+    // their own, `lamp_starts`), so it is not tried as two.
+    let seen: Vec<bool> = (0..start.len())
+        .map(|k| {
+            EdgeSide::ALL
+                .iter()
+                .all(|&side| problem.image_bound(&st, k, side).is_some())
+        })
+        .collect();
+    if split && seen.contains(&false) && problem.structured(&st) {
+        let tried: Vec<usize> = (0..start.len()).filter(|&k| !seen[k]).collect();
+        let whole = start.len() - tried.len();
+        progress.stage(&format!(
+            "joint fit: the residual is structured, as where two lights' reflections merge \
+             into one streak: trying light(s) {tried:?} as two{}",
+            if whole > 0 {
+                format!(" ({whole} seen whole in the photo, one lamp each, are not tried)")
+            } else {
+                String::new()
+            }
+        ));
+        for k in tried {
             let ways = match known.iter().find(|s| s.light == k) {
                 Some(s) => std::slice::from_ref(&s.way),
                 None => &SplitWay::ALL[..],
@@ -98,16 +124,26 @@ pub(super) fn optimise(
 }
 
 /// The state a fit starts from: the `start` lights, each inside its samples' extent, with an
-/// edge held where no streak-edge pixel looks at it and the photo does not show it directly.
+/// edge held where no streak-edge pixel looks at it and the photo does not show it directly;
+/// a light `held` gives a rectangle (when it has one per start light) is there, all its
+/// edges held ([`super::JointOptions::held`]).
 pub(super) fn start_state(
     problem: &Problem,
     start: &[FittedLight],
     extents: &[Option<Rect>],
+    held: &[Option<Rect>],
 ) -> State {
+    let held = |k: usize| {
+        held.get(k)
+            .copied()
+            .flatten()
+            .filter(|_| held.len() == start.len())
+    };
     let rects: Vec<Rect> = start
         .iter()
         .zip(extents.iter())
-        .map(|(l, e)| e.map_or(l.rect(), |e| l.rect().clamp_to(&e)))
+        .enumerate()
+        .map(|(k, (l, e))| held(k).unwrap_or_else(|| e.map_or(l.rect(), |e| l.rect().clamp_to(&e))))
         .collect();
     // An edge no streak-edge pixel looks at is held, unless the photo shows it directly.
     let pinned = start
@@ -117,10 +153,11 @@ pub(super) fn start_state(
         .map(|(k, (l, r))| {
             let direct = problem.direct_edge_pixels(k, r);
             EdgeSide::ALL.map(|side| {
-                matches!(
-                    l.edges[side],
-                    EdgeStatus::Unconstrained { unseen: true, .. }
-                ) && direct[side] == 0
+                held(k).is_some()
+                    || matches!(
+                        l.edges[side],
+                        EdgeStatus::Unconstrained { unseen: true, .. }
+                    ) && direct[side] == 0
             })
         })
         .collect();

@@ -2,6 +2,7 @@
 
 use super::proposal::Reweight;
 use super::Split;
+use crate::fitting::rect::Rect;
 use crate::optics::ReflectionModel;
 use crate::progress::Reporter;
 use crate::water_model::WaterModel;
@@ -79,6 +80,13 @@ pub struct JointOptions<'a> {
     /// automatic choice of the water model asks it whether the scene's waves could be the
     /// photo's at all before it spends the descent. `None` by default.
     pub start_gate: Option<StartGate<'a>>,
+    /// Rectangles to hold lights at, one entry per start light as the fit takes them (after
+    /// the starts are moved onto and split by the lamps' direct images): a light given one
+    /// starts there with every edge held, the others are fitted. A search whose fits all
+    /// start alike holds the lights a fit before it saw whole in the photo
+    /// ([`JointOutcome::seen_whole`](super::JointOutcome::seen_whole)). Used only when its
+    /// length is the start lights' count; empty by default.
+    pub held: &'a [Option<Rect>],
 }
 
 /// A test of a joint fit's start image ([`JointOptions::start_gate`]): the water pixels'
@@ -118,6 +126,7 @@ impl JointOptions<'_> {
             row_scales: None,
             reweight: None,
             start_gate: None,
+            held: &[],
         }
     }
 }

@@ -2,7 +2,7 @@
 
 use super::uncertainty::{edge_statuses, Uncertainty};
 use super::{ModelledPixel, Split};
-use crate::fitting::FittedLight;
+use crate::fitting::{FittedLight, Rect};
 
 /// The result of a joint fit.
 #[derive(Clone, Debug)]
@@ -38,6 +38,13 @@ pub struct JointOutcome {
     /// [`JointOptions::start_gate`](super::JointOptions::start_gate) said: then it has no
     /// light, and `modelled` is the start lights' expected image.
     pub stopped_at_start: bool,
+    /// By start light as the fit took them (after the starts are moved onto and split by the
+    /// lamps' direct images): the fitted rectangle of each the photo shows whole, every edge
+    /// pinned by its direct image within a pixel's footprint
+    /// ([`Uncertainty::image_bound`]), else `None`. Its image holds it there whatever the
+    /// water's lobe, so a search may too
+    /// ([`JointOptions::held`](super::JointOptions::held)).
+    pub seen_whole: Vec<Option<Rect>>,
 }
 
 impl JointOutcome {
@@ -55,6 +62,7 @@ impl JointOutcome {
             splits: Vec::new(),
             row_scales: None,
             stopped_at_start: false,
+            seen_whole: Vec::new(),
         }
     }
 

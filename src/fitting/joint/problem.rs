@@ -76,27 +76,38 @@ impl Problem {
         minus: &Rect,
         h: f32,
     ) -> (Vec<f32>, Vec<f32>) {
-        let samples = &self.planes[set];
         let strip = plus.changed_strip(minus);
+        let h = 2.0 * h as f64;
         (0..self.n())
             .into_par_iter()
             .map(|i| {
-                if !reaches(&samples.bbox[i], strip) {
-                    // The Gaussian alone can reach the strip: its exact mass, no samples.
-                    let g = &samples.gauss[i];
-                    if g.is_none() || !reaches(&g.reach(), strip) {
-                        return (0.0, 0.0);
-                    }
-                    return (
-                        (g.mass_inside(plus) - g.mass_inside(minus)) / (2.0 * h),
-                        0.0,
-                    );
-                }
-                let (dc, dd) = samples.coefficient_change(i, minus, plus, self.inv_samples);
-                let h = 2.0 * h as f64;
+                let (dc, dd) = self.pixel_change(set, i, minus, plus, strip);
                 ((dc / h) as f32, (dd / h) as f32)
             })
             .unzip()
+    }
+
+    /// Pixel i's change of sample set `set`'s coefficient and half-difference from `from` to
+    /// `to`, rectangles that differ in `strip` ([`Rect::changed_strip`]): from the samples
+    /// near it, or, where only the pixel's Gaussian reaches it, from the Gaussian's exact
+    /// mass (no samples, no half-difference).
+    pub(super) fn pixel_change(
+        &self,
+        set: usize,
+        i: usize,
+        from: &Rect,
+        to: &Rect,
+        strip: Option<Rect>,
+    ) -> (f64, f64) {
+        let samples = &self.planes[set];
+        if reaches(&samples.bbox[i], strip) {
+            return samples.coefficient_change(i, from, to, self.inv_samples);
+        }
+        let g = &samples.gauss[i];
+        if g.is_none() || !reaches(&g.reach(), strip) {
+            return (0.0, 0.0);
+        }
+        ((g.mass_inside(to) - g.mass_inside(from)) as f64, 0.0)
     }
 
     /// Moves light k to `rect`, recomputing only the coefficients of pixels with a sample

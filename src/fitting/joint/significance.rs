@@ -222,6 +222,7 @@ mod tests {
             radiance: [radiance; 3],
             direct_pixels: 0,
             radiance_seen: false,
+            image_bound: [None; 4],
         }
     }
 

@@ -24,6 +24,25 @@ pub struct Uncertainty {
     /// that its radiance is read off its image ([`Problem::sees_radiance`]); otherwise the
     /// reflections alone give it.
     pub radiance_seen: bool,
+    /// Per edge, the largest one-sigma error the light's direct image leaves it, metres
+    /// (`image_bound`: a pixel's footprint over sqrt(3) where a move by a footprint either way
+    /// would make the pixels that see the light disagree with the photo); `None` where the
+    /// image does not pin it. The edge's sigma never exceeds it ([`Uncertainty::bound_by_image`]).
+    pub image_bound: [Option<f32>; 4],
+}
+
+impl Uncertainty {
+    /// Each edge's sigma no larger than its [`image_bound`](Self::image_bound), and one given
+    /// where only the image constrains it. Whatever widens the sigmas (the repeats' spread,
+    /// the glitter's correlation) says how well the reflections place the edge; the image
+    /// places it within its pixels regardless.
+    pub fn bound_by_image(&mut self) {
+        for side in EdgeSide::ALL {
+            if let Some(b) = self.image_bound[side] {
+                self.edges[side] = Some(self.edges[side].map_or(b, |sd| sd.min(b)));
+            }
+        }
+    }
 }
 
 /// One-sigma uncertainties of every light's free edges and radiances, from their full
@@ -38,7 +57,9 @@ pub struct Uncertainty {
 /// millimetres at that distance the stored samples make the coefficients a staircase. A direct pixel's (`direct`) is taken over a quarter of its
 /// footprint, and only the pixels that measure the model count ([`Problem::measures`]: not
 /// clipped, and not black where the light is seen directly). An edge that moves nothing gets no uncertainty (`None`: the photo
-/// does not constrain it), and so does a pinned one.
+/// does not constrain it), and so does a pinned one. An edge the light's direct image pins
+/// within its pixels (`image_bound`: clipped on one side, black on the other) gets no more
+/// than that bound.
 pub(super) fn uncertainties(
     problem: &Problem,
     st: &State,
@@ -191,6 +212,7 @@ pub(super) fn uncertainties(
             radiance: [f32::INFINITY; 3],
             direct_pixels: 0,
             radiance_seen: false,
+            image_bound: [None; 4],
         })
         .collect();
     if let Some(cov) = covariance {
@@ -206,6 +228,10 @@ pub(super) fn uncertainties(
                 Param::Radiance(k, ch) => out[*k].radiance[*ch] = sd,
             }
         }
+    }
+    for (k, u) in out.iter_mut().enumerate() {
+        u.image_bound = EdgeSide::ALL.map(|side| problem.image_bound(st, k, side));
+        u.bound_by_image();
     }
     out
 }

@@ -156,7 +156,9 @@ pub fn parameter_slopes(points: &[(f64, Vec<FittedLight>)]) -> Option<Vec<[f64; 
 
 /// `uncertainty` of each light grown by `sqrt(area)` (the residual's correlation area), with
 /// the slope variances' uncertainties `sigma_ln` (already so grown) carried through the
-/// parameters' `slopes` by `ln` variance, per axis. Unconstrained edges stay unconstrained.
+/// parameters' `slopes` by `ln` variance, per axis. Unconstrained edges stay unconstrained,
+/// and an edge the light's direct image bounds stays within that bound
+/// ([`Uncertainty::bound_by_image`]).
 pub fn widen(
     uncertainty: &mut [Uncertainty],
     area: f64,
@@ -181,6 +183,7 @@ pub fn widen(
         for c in 0..3 {
             u.radiance[c] = ((u.radiance[c] as f64 * grow).powi(2) + carried(4 + c)).sqrt() as f32;
         }
+        u.bound_by_image();
     }
 }
 
@@ -237,11 +240,15 @@ mod tests {
             radiance: [0.1; 3],
             direct_pixels: 0,
             radiance_seen: false,
+            image_bound: [None, None, Some(0.015), None],
         }];
         widen(&mut u, 4.0, [Some(&s), None], [Some(0.1), None]);
         // Left: (0.03 * 2)^2 + (0.5 * 0.1)^2; radiance: (0.1 * 2)^2 + (2 * 0.1)^2.
         assert!((u[0].edges[EdgeSide::Left].unwrap() - 0.0781).abs() < 1e-3);
         assert_eq!(u[0].edges[EdgeSide::Right], None);
+        // Bottom: 0.01 * 2, more than its image allows; top: 0.01 * 2.
+        assert_eq!(u[0].edges[EdgeSide::Bottom], Some(0.015));
+        assert!((u[0].edges[EdgeSide::Top].unwrap() - 0.02).abs() < 1e-6);
         assert!((u[0].radiance[0] - 0.2828).abs() < 1e-3);
     }
 
@@ -253,6 +260,7 @@ mod tests {
             radiance: [0.3, 0.8, 0.0],
             direct_pixels: 0,
             radiance_seen: seen,
+            image_bound: [None; 4],
         };
         let mut u = vec![sigma(false), sigma(true)];
         realisation_floor(&mut u, &lights);
