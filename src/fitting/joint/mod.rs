@@ -348,11 +348,29 @@ pub fn fit_joint_with(
             });
         }
     }
-    options.progress.stage(&format!(
-        "joint fit: descent of {} light(s), {} sweeps",
-        start.len(),
-        options.sweeps
-    ));
+    let held = if options.held.len() == start.len() {
+        options.held.iter().filter(|r| r.is_some()).count()
+    } else {
+        0
+    };
+    options.progress.stage(&if held == start.len() {
+        format!(
+            "joint fit: {held} light(s) held where their lamps' images pin them, radiances solved"
+        )
+    } else if held > 0 {
+        format!(
+            "joint fit: descent of {} light(s), {} sweeps ({held} more held where their \
+             lamps' images pin them)",
+            start.len() - held,
+            options.sweeps
+        )
+    } else {
+        format!(
+            "joint fit: descent of {} light(s), {} sweeps",
+            start.len(),
+            options.sweeps
+        )
+    });
     let t1 = Instant::now();
     let (first, replay, splits) = optimise(
         &mut problem,
