@@ -25,17 +25,28 @@ use crate::fitting::EdgeSide;
 const MIN_RISE: f64 = 25.0;
 
 impl Problem {
-    /// The largest one-sigma error the light's direct image leaves edge `side` of light `k`
-    /// (module doc), metres on its plane; `None` where the image does not pin it (no direct
-    /// pixel, a held edge, or a move the photo does not refuse).
-    pub(super) fn image_bound(&self, st: &State, k: usize, side: EdgeSide) -> Option<f32> {
-        if st.pinned[k][side] || self.first_direct >= self.n() {
+    /// Per light of `st` and edge (left, right, bottom, top), the largest one-sigma error its
+    /// direct image leaves the edge (module doc), metres on its plane; `None` where the image
+    /// does not pin it (no direct pixel, a held edge, or a move the photo does not refuse).
+    pub(super) fn image_bounds(&self, st: &State) -> Vec<[Option<f32>; 4]> {
+        if self.first_direct >= self.n() {
+            return vec![[None; 4]; st.rects.len()];
+        }
+        let floor = MIN_RISE * self.residual_variance(st);
+        (0..st.rects.len())
+            .map(|k| EdgeSide::ALL.map(|side| self.image_bound(st, k, side, floor)))
+            .collect()
+    }
+
+    /// [`Problem::image_bounds`] of one edge, a move refused when it raises the direct
+    /// pixels' disagreement with the photo by more than `floor`.
+    fn image_bound(&self, st: &State, k: usize, side: EdgeSide, floor: f64) -> Option<f32> {
+        if st.pinned[k][side] {
             return None;
         }
         // A quarter of a pixel's footprint (`direct_step`).
         let footprint = 4.0 * self.direct_step(st.set_of[k], side.along_u())?;
         let r = st.rects[k];
-        let floor = MIN_RISE * self.residual_variance(st);
         let refused = |to: f32| {
             let moved = r.with_edge(side, to);
             moved.width() > 0.0

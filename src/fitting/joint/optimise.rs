@@ -6,9 +6,9 @@
 //! ([`Problem::structured`]), each light is tried as two, one above the other or side by side
 //! ([`try_split`]), and the split is kept when it removes most of that structure. A light the
 //! photo shows whole (every edge pinned by its direct image within a pixel's footprint:
-//! [`Problem::image_bound`]) is not tried: it is one lamp's image, whose direct pixels refuse a cut in half, and under the statistical
-//! model, whose residual is the glitter and always structured, its trials were most of the
-//! final fit's time. The second
+//! [`Problem::image_bounds`]) is not tried: it is one lamp's image, whose direct pixels
+//! refuse a cut in half, and under the statistical model, whose residual is the glitter and
+//! always structured, its trials were most of the final fit's time. The second
 //! light of a split then reads a sample set of its own, drawn independently on the same
 //! plane, and the boundary between the two is searched globally ([`search_boundary`]) before
 //! the final descent. A repeat on other samples ([`Problem::replay`]) starts from where the
@@ -51,13 +51,15 @@ pub(super) fn optimise(
     // A light whose every edge its direct image pins (`image_bound`) is one lamp's image:
     // its reflections need no second light (lamps with images of their own start lights of
     // their own, `lamp_starts`), so it is not tried as two.
-    let seen: Vec<bool> = (0..start.len())
-        .map(|k| {
-            EdgeSide::ALL
-                .iter()
-                .all(|&side| problem.image_bound(&st, k, side).is_some())
-        })
-        .collect();
+    let seen: Vec<bool> = if split {
+        problem
+            .image_bounds(&st)
+            .iter()
+            .map(|b| b.iter().all(Option::is_some))
+            .collect()
+    } else {
+        Vec::new()
+    };
     if split && seen.contains(&false) && problem.structured(&st) {
         let tried: Vec<usize> = (0..start.len()).filter(|&k| !seen[k]).collect();
         let whole = start.len() - tried.len();

@@ -229,8 +229,8 @@ pub(super) fn uncertainties(
             }
         }
     }
-    for (k, u) in out.iter_mut().enumerate() {
-        u.image_bound = EdgeSide::ALL.map(|side| problem.image_bound(st, k, side));
+    for (u, bound) in out.iter_mut().zip(problem.image_bounds(st)) {
+        u.image_bound = bound;
         u.bound_by_image();
     }
     out
