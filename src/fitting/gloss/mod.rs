@@ -109,8 +109,8 @@ pub(super) mod search;
 use std::time::Instant;
 
 use super::joint::{
-    fit_joint, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache, Reweight, Split,
-    StartGate, Uncertainty,
+    fit_joint, place_starts, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache,
+    Reweight, Split, StartGate, Uncertainty,
 };
 use super::{fit_paper, FitOptions, FittedLight, Rect, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
@@ -311,6 +311,12 @@ pub fn estimate_gloss(
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
     let start = search_start(&paper, streaks.len(), "gloss")?;
     let mut warnings = paper.warnings.clone();
+    // Every fit starts alike: the direct view places the starts once.
+    let start = if final_fit.direct_view {
+        place_starts(scene, photo, water, streaks, &start, final_fit.progress)
+    } else {
+        start
+    };
 
     let t = Instant::now();
     let mut cost = Cost {
@@ -520,6 +526,7 @@ impl Curve for &mut Cost<'_> {
                     target: Lobe::Exact { gloss },
                 }),
                 start_gate: self.gate.filter(|_| self.evaluations.is_empty()),
+                starts_placed: true,
                 held: self.held.as_deref().unwrap_or(&[]),
                 ..JointOptions::new(
                     ReflectionModel {

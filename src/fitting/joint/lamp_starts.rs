@@ -28,12 +28,13 @@
 use glam::Vec3;
 
 use super::direct_images::{images_in, DirectImage};
-use super::direct_start::overlap;
+use super::direct_start::{direct_starts, overlap};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::observation::StreakObservation;
 use crate::fitting::rect::Rect;
 use crate::fitting::FittedLight;
 use crate::photo_in::Photo;
+use crate::progress::Reporter;
 use crate::scene_in::Scene;
 
 /// The smallest share of the box around two lamps' images that each must make for a start
@@ -52,6 +53,40 @@ const BOX_MARGIN: f32 = 0.02;
 /// A light overlapping a lamp's image by at least this (intersection over union) starts on
 /// that lamp.
 const ON_IMAGE: f32 = 0.5;
+
+/// The start lights a joint fit with the direct view takes for `start`: moved onto their
+/// lamps' direct images and merged where they meet ([`super::direct_start`]), then split and
+/// added to one per lamp ([`one_light_per_lamp`]); `progress` hears of each change. A search
+/// whose fits all start alike places them once and gives them with
+/// [`JointOptions::starts_placed`](super::JointOptions::starts_placed).
+pub fn place_starts(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    start: &[FittedLight],
+    progress: Reporter<'_>,
+) -> Vec<FittedLight> {
+    let on_images = direct_starts(scene, photo, water, start);
+    if on_images.len() < start.len() {
+        progress.stage(&format!(
+            "joint fit: {} of {} start light(s) merged into another whose lamp's direct image \
+             they lay on",
+            start.len() - on_images.len(),
+            start.len()
+        ));
+    }
+    let before = on_images.len();
+    let placed = one_light_per_lamp(scene, photo, water, streaks, on_images);
+    if placed.len() > before {
+        progress.stage(&format!(
+            "joint fit: {} lamp(s) in the photo whose reflections share another light's streak \
+             start a light of their own",
+            placed.len() - before
+        ));
+    }
+    placed
+}
 
 /// The lights of `lights` split and added to one per lamp (module doc).
 pub(crate) fn one_light_per_lamp(

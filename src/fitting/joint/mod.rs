@@ -143,6 +143,7 @@ pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty};
 
 use direct::direct_pixels;
+pub use lamp_starts::place_starts;
 use optimise::{optimise, start_state};
 use problem::{Problem, State};
 use region::{region, region_of_interest};
@@ -201,27 +202,11 @@ pub fn fit_joint_with(
     if start.is_empty() {
         return Ok(JointOutcome::empty());
     }
-    // Starts far from the lights' direct images are moved onto them (`direct_start`).
+    // Starts far from the lights' direct images are moved onto them, one light per lamp
+    // (`place_starts`).
     let moved;
-    let start = if options.direct_view {
-        let on_images = direct_start::direct_starts(scene, photo, water, start);
-        if on_images.len() < start.len() {
-            options.progress.stage(&format!(
-                "joint fit: {} of {} start light(s) merged into another whose lamp's direct \
-                 image they lay on",
-                start.len() - on_images.len(),
-                start.len()
-            ));
-        }
-        let before = on_images.len();
-        moved = lamp_starts::one_light_per_lamp(scene, photo, water, streaks, on_images);
-        if moved.len() > before {
-            options.progress.stage(&format!(
-                "joint fit: {} lamp(s) in the photo whose reflections share another light's \
-                 streak start a light of their own",
-                moved.len() - before
-            ));
-        }
+    let start = if options.direct_view && !options.starts_placed {
+        moved = place_starts(scene, photo, water, streaks, start, options.progress);
         &moved[..]
     } else {
         start

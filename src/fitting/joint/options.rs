@@ -87,6 +87,10 @@ pub struct JointOptions<'a> {
     /// ([`JointOutcome::seen_whole`](super::JointOutcome::seen_whole)). Used only when its
     /// length is the start lights' count; empty by default.
     pub held: &'a [Option<Rect>],
+    /// The start lights are already where the direct view puts them
+    /// ([`place_starts`](super::place_starts)): the fit takes them as they are. A search
+    /// whose fits all start from the same lights places them once. Off by default.
+    pub starts_placed: bool,
 }
 
 /// A test of a joint fit's start image ([`JointOptions::start_gate`]): the water pixels'
@@ -127,6 +131,7 @@ impl JointOptions<'_> {
             reweight: None,
             start_gate: None,
             held: &[],
+            starts_placed: false,
         }
     }
 }

@@ -17,11 +17,12 @@
 //! estimate of the axis it left lies within the search's tolerance of that fit), so the
 //! middle of its first three points is a fit already made: two fits fewer of the eleven a
 //! full search took on Table 1's photo over a flat quad, the estimates within 0.3 %.
-//! Every fit starts from the same lights (the paper fit at the starting variances), reads the
+//! Every fit starts from the same lights (the paper fit at the starting variances, placed on
+//! the lamps' direct images once: [`super::joint::place_starts`]), reads the
 //! same pixels (those the broadest lobe of the search can see: four times the starting
 //! variances) with the same random numbers, so the costs are comparable. A light the first
-//! fit saw whole in the photo ([`super::joint::JointOutcome::seen_whole`]: every edge crossed
-//! by pixels that see it directly) is pinned by its image whatever the lobe, so every later
+//! fit saw whole in the photo ([`super::joint::JointOutcome::seen_whole`]: every edge pinned
+//! by its direct image within a pixel's footprint) is pinned by it whatever the lobe, so every later
 //! fit holds it there ([`JointOptions::held`]) and solves only its radiance: over the
 //! harbour's lights in frame the search then took 2-3 s rather than 5-9 s, the lights the
 //! same to 0.1 %, the variances along within 1 % and across within 14 % (docs/decisions.md).
@@ -49,7 +50,7 @@ pub use uncertainty::{
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
 use super::joint::{
-    fit_joint_with, JointOptions, Lobe, ProposalCache, Reweight, Split, Uncertainty,
+    fit_joint_with, place_starts, JointOptions, Lobe, ProposalCache, Reweight, Split, Uncertainty,
 };
 use super::{fit_paper_with, FitOptions, FittedLight, Rect, Skipped, StreakObservation};
 use crate::optics::{GaussianSlopes, ReflectionModel};
@@ -187,6 +188,12 @@ pub fn estimate_slopes(
     let start = search_start(&paper_fit, streaks.len(), "waves' slope")?;
     let mut warnings = paper_fit.warnings.clone();
     let broad = water_with_total(surface, start_variance.map(|v| (4.0 * v).min(hi)));
+    // Every fit starts alike: the direct view places the starts once.
+    let start = if final_fit.direct_view {
+        place_starts(scene, photo, water, streaks, &start, final_fit.progress)
+    } else {
+        start
+    };
     let search_options = JointOptions {
         samples: options.search_samples,
         sweeps: options.search_sweeps,
@@ -196,6 +203,8 @@ pub fn estimate_slopes(
         region_water: Some(&broad),
         progress: final_fit.progress,
         stacked_as_one: final_fit.stacked_as_one,
+        direct_view: final_fit.direct_view,
+        starts_placed: true,
         ..JointOptions::new(model, paper.seed)
     };
     // Each axis's last pass: (ln variance, the lights fitted there).
