@@ -55,8 +55,8 @@ const BOX_MARGIN: f32 = 0.02;
 const ON_IMAGE: f32 = 0.5;
 
 /// The start lights a joint fit with the direct view takes for `start`: moved onto their
-/// lamps' direct images and merged where they meet ([`super::direct_start`]), then split and
-/// added to one per lamp ([`one_light_per_lamp`]); `progress` hears of each change. A search
+/// lamps' direct images and merged where they meet (`direct_start`), then split and added to
+/// one per lamp (this module's doc); `progress` hears of each change. A search
 /// whose fits all start alike places them once and gives them with
 /// [`JointOptions::starts_placed`](super::JointOptions::starts_placed).
 pub fn place_starts(
