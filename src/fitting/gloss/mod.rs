@@ -546,14 +546,7 @@ impl Curve for &mut Cost<'_> {
             });
         }
         if self.held.is_none() {
-            let seen = fit.seen_whole.iter().filter(|r| r.is_some()).count();
-            if seen > 0 {
-                self.fit.progress.stage(&format!(
-                    "gloss search: {seen} light(s) seen whole in the photo held where this fit \
-                     put them"
-                ));
-            }
-            self.held = Some(fit.seen_whole);
+            self.held = Some(fit.to_hold("gloss search", self.fit.progress));
         }
         let mut s = fit.cost;
         // The residuals hold the photo's own noise, so a cost that is not positive is the fit

@@ -3,6 +3,7 @@
 use super::uncertainty::{edge_statuses, Uncertainty};
 use super::{ModelledPixel, Split};
 use crate::fitting::{FittedLight, Rect};
+use crate::progress::Reporter;
 
 /// The result of a joint fit.
 #[derive(Clone, Debug)]
@@ -64,6 +65,19 @@ impl JointOutcome {
             stopped_at_start: false,
             seen_whole: Vec::new(),
         }
+    }
+
+    /// [`seen_whole`](Self::seen_whole), for a search (`what`, as its progress lines name it)
+    /// whose later fits hold those lights ([`JointOptions::held`](super::JointOptions::held));
+    /// `progress` hears how many there are.
+    pub fn to_hold(&self, what: &str, progress: Reporter<'_>) -> Vec<Option<Rect>> {
+        let seen = self.seen_whole.iter().filter(|r| r.is_some()).count();
+        if seen > 0 {
+            progress.stage(&format!(
+                "{what}: {seen} light(s) seen whole in the photo held where this fit put them"
+            ));
+        }
+        self.seen_whole.clone()
     }
 
     /// The refined lights, each edge's status taken from its uncertainty ([`edge_statuses`]:

@@ -263,14 +263,7 @@ pub fn estimate_slopes(
             },
         )?;
         if whole.get().is_none() {
-            let seen = fit.seen_whole.iter().filter(|r| r.is_some()).count();
-            if seen > 0 {
-                final_fit.progress.stage(&format!(
-                    "slope search: {seen} light(s) seen whole in the photo held where this fit \
-                     put them"
-                ));
-            }
-            let _ = whole.set(fit.seen_whole.clone());
+            let _ = whole.set(fit.to_hold("slope search", final_fit.progress));
         }
         if weighted && search_scales.get().is_none() {
             if let Some(s) = fit.row_scales.clone() {
