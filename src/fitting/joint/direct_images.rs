@@ -34,6 +34,8 @@ pub(super) struct DirectImage {
     /// overlaps, what the start is trimmed to (two stacked lamps are two images under one
     /// start).
     pub(super) reach: Rect,
+    /// A pixel's footprint on the plane at the image's mean distance from the camera, metres.
+    pub(super) footprint: f32,
 }
 
 /// The direct images on `plane` inside `search` (module doc), each with `reach` its own
@@ -139,6 +141,7 @@ pub(super) fn images_in(
                 rect: rect.grow(half_pixel),
                 enclosed: enclosed(&g),
                 reach: rect.grow(half_pixel),
+                footprint: 2.0 * half_pixel,
             }
         })
         .collect()

@@ -128,6 +128,20 @@ pub(super) fn overlap(a: &Rect, b: &Rect) -> f32 {
     }
 }
 
+/// Where `light`'s lamp ends, when its start lies on a direct image the photo shows whole
+/// (every pixel around it sees the wall: not cut by the frame, the water or anything in
+/// front): the rectangle of every image the start overlaps, and a pixel's footprint there.
+/// The light then ends within about a footprint of that rectangle's edges.
+pub(super) fn enclosing_image(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    light: &FittedLight,
+) -> Option<(Rect, f32)> {
+    let im = direct_image(scene, photo, water, light)?;
+    (im.enclosed && overlap(&light.rect(), &im.reach) > 0.0).then_some((im.reach, im.footprint))
+}
+
 /// The direct image near `light` (module doc), or `None` when the photo shows none.
 fn direct_image(
     scene: &Scene,
@@ -248,6 +262,60 @@ pub(super) mod tests {
         let kept = direct_starts(&scene, &photo, &water, &[light(&plane, inside, 0)]);
         assert_eq!(kept.len(), 1);
         assert_eq!(kept[0].rect(), inside);
+    }
+
+    /// A start on the light's whole image learns where the light ends: the image's
+    /// rectangle within a pixel's footprint of the truth on every edge, and that footprint
+    /// as a pixel's angle (60 degrees over 600 pixels) times a distance between the light's
+    /// nearest and farthest corners from the camera. The same start with a row
+    /// of pixels above the image marked as water (the image may be cut there) learns nothing,
+    /// nor does a start off the image.
+    #[test]
+    fn a_start_on_a_whole_image_learns_where_the_light_ends() {
+        let (scene, photo, water, plane, truth) = table1();
+        let footprint = 10.0 * 2.0 * (30f32.to_radians()).tan() / photo.height as f32;
+        let start = light(&plane, truth.grow(-0.3), 0);
+        let (image, measured) =
+            enclosing_image(&scene, &photo, &water, &start).expect("a whole image");
+        assert_within(&image, &truth, footprint);
+        // A pixel's angle times the camera's distance, between the light's nearest corner
+        // and its farthest.
+        let distances: Vec<f32> = [
+            (truth.u_min, truth.v_min),
+            (truth.u_min, truth.v_max),
+            (truth.u_max, truth.v_min),
+            (truth.u_max, truth.v_max),
+        ]
+        .iter()
+        .map(|&(u, v)| (plane.point_at(u, v) - scene.camera.position).length())
+        .collect();
+        let angle = footprint / 10.0;
+        let (near, far) = distances
+            .iter()
+            .fold((f32::INFINITY, 0.0f32), |(a, b), &d| (a.min(d), b.max(d)));
+        assert!(
+            (angle * near..=angle * far).contains(&measured),
+            "footprint {measured}, not between {} and {}",
+            angle * near,
+            angle * far
+        );
+        let rows: Vec<usize> = (0..photo.radiance.len())
+            .filter(|&i| photo.clipped[i] && !water[i])
+            .map(|i| i / photo.width as usize)
+            .collect();
+        let top = *rows.iter().min().expect("the image's rows");
+        let mut cut = water.clone();
+        let w = photo.width as usize;
+        cut[(top - 1) * w..top * w]
+            .iter_mut()
+            .for_each(|m| *m = true);
+        assert!(enclosing_image(&scene, &photo, &cut, &start).is_none());
+        let off = Rect {
+            u_min: truth.u_max + 3.0,
+            u_max: truth.u_max + 4.0,
+            ..truth
+        };
+        assert!(enclosing_image(&scene, &photo, &water, &light(&plane, off, 0)).is_none());
     }
 
     /// A start that overlaps the light's image well but reaches beyond it (as a grazing

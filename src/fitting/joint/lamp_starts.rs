@@ -279,6 +279,7 @@ mod tests {
             rect: r,
             enclosed: true,
             reach: r,
+            footprint: 0.01,
         }
     }
 

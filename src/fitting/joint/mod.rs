@@ -143,6 +143,7 @@ pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty};
 
 use direct::direct_pixels;
+use direct_start::enclosing_image;
 pub use lamp_starts::place_starts;
 use optimise::{optimise, start_state};
 use problem::{Problem, State};
@@ -226,7 +227,18 @@ pub fn fit_joint_with(
     }
     let t0 = Instant::now();
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
-    let roi: Vec<Rect> = start.iter().map(region_of_interest).collect();
+    // A light on a lamp's whole direct image searches close around it (`region_of_interest`),
+    // but in a gloss search: there a fit at a gloss far from the photo's needs its lights
+    // free to grow and shrink (held close, Table 3's gloss from e = 100 came out at 263).
+    let (roi, kernel_caps): (Vec<Rect>, Vec<f32>) = start
+        .iter()
+        .map(|light| {
+            let image = (options.direct_view && options.region_gloss.is_none())
+                .then(|| enclosing_image(scene, photo, water, light))
+                .flatten();
+            region_of_interest(light, image)
+        })
+        .unzip();
     let probe_model = ReflectionModel {
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model
@@ -256,7 +268,8 @@ pub fn fit_joint_with(
             options.pixels,
         ));
     }
-    let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
+    // `origins`: the start light of each plane traced.
+    let trace = |origins: &[usize], repeat: u32, draw: u32| {
         let fit = proposal::FitSamples {
             water_model,
             scene,
@@ -264,10 +277,17 @@ pub fn fit_joint_with(
             size: (photo.width, photo.height),
             first_direct,
         };
-        fit.samples(options, planes, roi, repeat, draw)
+        let traced_planes: Vec<&LightPlane> = origins.iter().map(|&k| planes[k]).collect();
+        let traced_roi: Vec<Rect> = origins.iter().map(|&k| roi[k]).collect();
+        let (mut stored, n) = fit.samples(options, &traced_planes, &traced_roi, repeat, draw);
+        for (set, &k) in stored.iter_mut().zip(origins) {
+            set.cap_kernels(kernel_caps[k]);
+        }
+        (stored, n)
     };
+    let all: Vec<usize> = (0..planes.len()).collect();
     let problem_for = |repeat: u32| {
-        let (stored, per_pixel_samples) = trace(&planes, &roi, repeat, 0);
+        let (stored, per_pixel_samples) = trace(&all, repeat, 0);
         Problem {
             width: photo.width,
             pixel_ids: pixels.clone(),
@@ -293,7 +313,7 @@ pub fn fit_joint_with(
     // independent of every other set.
     let fresh_set = |repeat: u32, origin: usize, draw: u32| {
         let t = Instant::now();
-        let (mut stored, _) = trace(&[planes[origin]], &[roi[origin]], repeat, draw);
+        let (mut stored, _) = trace(&[origin], repeat, draw);
         fresh_seconds.set(fresh_seconds.get() + t.elapsed().as_secs_f64());
         // One plane in, one set out, weighted as the others.
         let mut set = stored.swap_remove(0);
