@@ -34,7 +34,7 @@ pub(super) fn table3_light0() -> Table3Light0 {
     let paper = crate::fitting::fit_paper(&scene, &photo, &water, &observations, &options)
         .expect("paper fit");
     let light = paper.lights[0].clone();
-    let (roi, _) = region_of_interest(&light, None);
+    let roi = region_of_interest(&light, None);
     let used: Vec<&StreakObservation> = observations.iter().collect();
     let pixels: Vec<u32> = region(
         &ExactSurface,

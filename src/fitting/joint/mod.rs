@@ -230,7 +230,7 @@ pub fn fit_joint_with(
     // A light on a lamp's whole direct image searches close around it (`region_of_interest`),
     // but in a gloss search: there a fit at a gloss far from the photo's needs its lights
     // free to grow and shrink (held close, Table 3's gloss from e = 100 came out at 263).
-    let (roi, kernel_caps): (Vec<Rect>, Vec<f32>) = start
+    let roi: Vec<Rect> = start
         .iter()
         .map(|light| {
             let image = (options.direct_view && options.region_gloss.is_none())
@@ -238,7 +238,7 @@ pub fn fit_joint_with(
                 .flatten();
             region_of_interest(light, image)
         })
-        .unzip();
+        .collect();
     let probe_model = ReflectionModel {
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model
@@ -268,8 +268,7 @@ pub fn fit_joint_with(
             options.pixels,
         ));
     }
-    // `origins`: the start light of each plane traced.
-    let trace = |origins: &[usize], repeat: u32, draw: u32| {
+    let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
         let fit = proposal::FitSamples {
             water_model,
             scene,
@@ -277,17 +276,10 @@ pub fn fit_joint_with(
             size: (photo.width, photo.height),
             first_direct,
         };
-        let traced_planes: Vec<&LightPlane> = origins.iter().map(|&k| planes[k]).collect();
-        let traced_roi: Vec<Rect> = origins.iter().map(|&k| roi[k]).collect();
-        let (mut stored, n) = fit.samples(options, &traced_planes, &traced_roi, repeat, draw);
-        for (set, &k) in stored.iter_mut().zip(origins) {
-            set.cap_kernels(kernel_caps[k]);
-        }
-        (stored, n)
+        fit.samples(options, planes, roi, repeat, draw)
     };
-    let all: Vec<usize> = (0..planes.len()).collect();
     let problem_for = |repeat: u32| {
-        let (stored, per_pixel_samples) = trace(&all, repeat, 0);
+        let (stored, per_pixel_samples) = trace(&planes, &roi, repeat, 0);
         Problem {
             width: photo.width,
             pixel_ids: pixels.clone(),
@@ -313,7 +305,7 @@ pub fn fit_joint_with(
     // independent of every other set.
     let fresh_set = |repeat: u32, origin: usize, draw: u32| {
         let t = Instant::now();
-        let (mut stored, _) = trace(&[origin], repeat, draw);
+        let (mut stored, _) = trace(&[planes[origin]], &[roi[origin]], repeat, draw);
         fresh_seconds.set(fresh_seconds.get() + t.elapsed().as_secs_f64());
         // One plane in, one set out, weighted as the others.
         let mut set = stored.swap_remove(0);

@@ -133,8 +133,8 @@ fn sees_region_of_interest(
     })
 }
 
-/// Where on its plane a light's edges may go during the fit (samples landing outside it are
-/// never traced), and the widest its samples' kernels may be (half-width, metres).
+/// Where on its plane a light's edges may go during the fit: samples landing outside it are
+/// never traced.
 ///
 /// By default the region is the start rectangle grown by the first search window and a
 /// little more: a start from the reflections alone may be off by half its size. A light
@@ -142,24 +142,22 @@ fn sees_region_of_interest(
 /// and a pixel's footprint there, [`super::direct_start::enclosing_image`]) ends within about
 /// a footprint of the image's edges, so its region is the start and the image grown by a
 /// margin of [`IMAGE_MARGIN_SHARE`] of the image's larger side, at least
-/// [`IMAGE_MARGIN_FOOTPRINTS`] footprints. Its kernels are then capped at half that margin
-/// ([`PlaneSamples::cap_kernels`](super::samples::PlaneSamples::cap_kernels)): a sample
-/// landing outside the region is never traced, and with a wider kernel it would have reached
-/// into the light; capped, none reaches a light half a margin inside the region, so its
-/// coefficients are those of every sample the wide region would hold.
-pub(super) fn region_of_interest(start: &FittedLight, image: Option<(Rect, f32)>) -> (Rect, f32) {
+/// [`IMAGE_MARGIN_FOOTPRINTS`] footprints.
+pub(super) fn region_of_interest(start: &FittedLight, image: Option<(Rect, f32)>) -> Rect {
     let rect = start.rect();
-    let window = first_window(&rect, start.plane.camera_distance());
-    let default = (rect.grow(1.25 * window), f32::INFINITY);
+    let default = rect.grow(1.25 * first_window(&rect, start.plane.camera_distance()));
     let Some((image, footprint)) = image else {
         return default;
     };
     let margin = (IMAGE_MARGIN_SHARE * image.width().max(image.height()))
         .max(IMAGE_MARGIN_FOOTPRINTS * footprint);
-    if margin >= 1.25 * window || margin.is_nan() {
-        return default;
+    let close = rect.union(&image).grow(margin);
+    // Never wider than the default.
+    if close.width() * close.height() < default.width() * default.height() {
+        close
+    } else {
+        default
     }
-    (rect.union(&image).grow(margin), 0.5 * margin)
 }
 
 /// The margin of a region of interest around a light's whole direct image, as a share of the
@@ -189,12 +187,11 @@ mod tests {
         assert!(d.iter().all(|d| d.abs() < 1e-5), "{got:?} against {want:?}");
     }
 
-    /// A 3 x 2 m start 10 m from the camera. With no whole image it may move by 1.25 times
-    /// half its larger side (1.875 m), its kernels as wide as they come; on a whole image
-    /// of 3.1 x 2.1 m seen with 1 cm footprints, 5 % of the image's 3.1 m (0.155 m) around
-    /// the start and the image together, its kernels at most half that; with 10 cm
-    /// footprints, 4 of them (0.4 m). A footprint so coarse that the margin would pass
-    /// the default region gives the default.
+    /// A 3 x 2 m start 10 m from the camera. With no whole image its edges may move by 1.25
+    /// times half its larger side (1.875 m); on a whole image of 3.1 x 2.1 m seen with 1 cm
+    /// footprints, by 5 % of the image's 3.1 m (0.155 m) around the start and the image
+    /// together; with 10 cm footprints, by 4 of them (0.4 m). A footprint so coarse that the
+    /// region would pass the default gives the default.
     #[test]
     fn a_light_on_its_whole_image_searches_close_around_it() {
         let plane =
@@ -202,19 +199,20 @@ mod tests {
                 .expect("a plane");
         let start = rect(0.0, 3.0, 0.0, 2.0);
         let light = start_light(&plane, start, 0);
-        let (roi, cap) = region_of_interest(&light, None);
-        assert_close(roi, start.grow(1.875));
-        assert_eq!(cap, f32::INFINITY);
+        assert_close(region_of_interest(&light, None), start.grow(1.875));
         let image = rect(-0.05, 3.05, 0.1, 2.2);
         let union = rect(-0.05, 3.05, 0.0, 2.2);
-        let (roi, cap) = region_of_interest(&light, Some((image, 0.01)));
-        assert_close(roi, union.grow(0.155));
-        assert!((cap - 0.155 / 2.0).abs() < 1e-6, "{cap}");
-        let (roi, cap) = region_of_interest(&light, Some((image, 0.1)));
-        assert_close(roi, union.grow(0.4));
-        assert!((cap - 0.4 / 2.0).abs() < 1e-6, "{cap}");
-        let (roi, cap) = region_of_interest(&light, Some((image, 0.5)));
-        assert_close(roi, start.grow(1.875));
-        assert_eq!(cap, f32::INFINITY);
+        assert_close(
+            region_of_interest(&light, Some((image, 0.01))),
+            union.grow(0.155),
+        );
+        assert_close(
+            region_of_interest(&light, Some((image, 0.1))),
+            union.grow(0.4),
+        );
+        assert_close(
+            region_of_interest(&light, Some((image, 0.5))),
+            start.grow(1.875),
+        );
     }
 }

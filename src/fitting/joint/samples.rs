@@ -62,27 +62,6 @@ pub(super) struct PlaneSamples {
 }
 
 impl PlaneSamples {
-    /// Every lobe sample's kernel no wider than `cap` either side along either axis (a direct
-    /// pixel's plain box is kept; an infinite `cap` changes nothing). A kernel estimates the
-    /// lobe convolved with it whatever its width (`super::kernel`): a narrower one only
-    /// smooths less. The per-pixel bounds (`bbox`, `reach`) stay as traced, wider than need be.
-    pub(super) fn cap_kernels(&mut self, cap: f32) {
-        let lobe_cell = |c: &Vec2| c.x >= 0.0 && c.y >= 0.0;
-        if !cap.is_finite()
-            || self
-                .cells
-                .iter()
-                .all(|c| !lobe_cell(c) || c.max_element() <= cap)
-        {
-            return;
-        }
-        for c in Arc::make_mut(&mut self.cells).iter_mut() {
-            if lobe_cell(c) {
-                *c = c.min(Vec2::splat(cap));
-            }
-        }
-    }
-
     /// Pixel i's samples in the per-sample vectors.
     pub(super) fn range(&self, i: usize) -> std::ops::Range<usize> {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
