@@ -490,7 +490,7 @@ fn close_to_the_water_the_photos_waves_hold_less_light_than_their_expectation() 
 /// photo, and the photo holds 5.4 % less light over the water than the statistical model's
 /// expectation at the waves' own slope variances (3 % less at 0.7 times them, 3 % more at 1.4
 /// times). One realisation of the waves, not the model, sets how far that radiance can be
-/// trusted: the fit gives it 3.8 % low (README).
+/// trusted: the fit gives it 4.0 % low (README).
 #[test]
 fn the_signs_photo_holds_less_light_than_its_expectation() {
     use streaklight::render::{render_with_lights, RenderOptions};

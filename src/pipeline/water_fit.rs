@@ -259,6 +259,7 @@ impl Run<'_> {
                     model,
                     stacked_as_one: true,
                     glitter_weights: true,
+                    close_regions: false,
                     ..self.joint_options(j, j.reading)
                 };
                 let est = estimate_slopes(

@@ -520,6 +520,7 @@ impl Curve for &mut Cost<'_> {
                 // would fit the lobe's error, not a second light.
                 split: false,
                 region_gloss: Some(region_gloss(self.options, self.fit.model.gloss)),
+                close_regions: false,
                 direct_view: self.fit.direct_view,
                 reweight: Some(Reweight {
                     cache: &self.proposal,

@@ -227,13 +227,12 @@ pub fn fit_joint_with(
     }
     let t0 = Instant::now();
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
-    // A light on a lamp's whole direct image searches close around it (`region_of_interest`),
-    // but in a gloss search: there a fit at a gloss far from the photo's needs its lights
-    // free to grow and shrink (held close, Table 3's gloss from e = 100 came out at 263).
+    // A light on a lamp's whole direct image searches close around it where asked
+    // (`region_of_interest`, `JointOptions::close_regions`).
     let roi: Vec<Rect> = start
         .iter()
         .map(|light| {
-            let image = (options.direct_view && options.region_gloss.is_none())
+            let image = (options.direct_view && options.close_regions)
                 .then(|| enclosing_image(scene, photo, water, light))
                 .flatten();
             region_of_interest(light, image)

@@ -204,6 +204,7 @@ pub fn estimate_slopes(
         progress: final_fit.progress,
         stacked_as_one: final_fit.stacked_as_one,
         direct_view: final_fit.direct_view,
+        close_regions: final_fit.close_regions,
         starts_placed: true,
         ..JointOptions::new(model, paper.seed)
     };
