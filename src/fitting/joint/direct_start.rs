@@ -225,6 +225,17 @@ pub(super) mod tests {
 
     use crate::fitting::joint::fixture::start_light as light;
 
+    /// The first and last rows of the lamp's image: those of the clipped pixels off the water.
+    fn image_rows(photo: &Photo, water: &[bool]) -> (usize, usize) {
+        let rows: Vec<usize> = (0..photo.radiance.len())
+            .filter(|&i| photo.clipped[i] && !water[i])
+            .map(|i| i / photo.width as usize)
+            .collect();
+        let top = *rows.iter().min().expect("the image's rows");
+        let bottom = *rows.iter().max().expect("the image's rows");
+        (top, bottom)
+    }
+
     /// A start 14 m wide and 1 cm tall across the light (as the reflections alone gave one)
     /// moves onto the light's direct image: every edge within a pixel's footprint on the
     /// wall (10 m away, 60 degrees over 600 pixels: 1.8 cm) of the truth. A second start
@@ -299,11 +310,7 @@ pub(super) mod tests {
             angle * near,
             angle * far
         );
-        let rows: Vec<usize> = (0..photo.radiance.len())
-            .filter(|&i| photo.clipped[i] && !water[i])
-            .map(|i| i / photo.width as usize)
-            .collect();
-        let top = *rows.iter().min().expect("the image's rows");
+        let (top, _) = image_rows(&photo, &water);
         let mut cut = water.clone();
         let w = photo.width as usize;
         cut[(top - 1) * w..top * w]
@@ -339,12 +346,7 @@ pub(super) mod tests {
             let got = out[0].rect();
             assert_within(&got, &truth, footprint);
         }
-        // The image's rows: the clipped pixels' off the water.
-        let rows: Vec<usize> = (0..photo.radiance.len())
-            .filter(|&i| photo.clipped[i] && !water[i])
-            .map(|i| i / photo.width as usize)
-            .collect();
-        let (top, bottom) = (*rows.iter().min().unwrap(), *rows.iter().max().unwrap());
+        let (top, bottom) = image_rows(&photo, &water);
         // Two stacked lamps: the image cut in two by three dark rows across its middle. A
         // start over both, reaching 0.2 m beyond them (overlapping each by more than a
         // quarter), is trimmed to both, not to the one nearer its centre.
