@@ -125,8 +125,9 @@ pub struct Args {
     /// 32-288.
     #[arg(long, value_name = "N", value_parser = super::values::count)]
     pub joint_samples: Option<u32>,
-    /// Fit every water pixel near the streaks instead of every second one (a checkerboard):
-    /// about twice the joint fit's time, and less of both the samples' and the photo's noise
+    /// Fit every water pixel near the streaks instead of every second one (a checkerboard;
+    /// every fourth, one of each 2 x 2 block, on a photo of more than a megapixel): about twice
+    /// (four times) the joint fit's time, and less of both the samples' and the photo's noise
     /// (more samples per pixel cannot average the photo's noise). Lights sharing a streak get
     /// this by default (see --joint-samples).
     #[arg(long)]

@@ -25,7 +25,9 @@ pub use water_choice::{
 
 use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
-use crate::fitting::joint::{fit_joint_with, JointOptions, Split, StartGate, Uncertainty};
+use crate::fitting::joint::{
+    fit_joint_with, JointOptions, PixelShare, Split, StartGate, Uncertainty,
+};
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
@@ -56,6 +58,9 @@ pub struct Lit {
     pub gloss_source: String,
     /// What the final joint fit read (`None` for the paper's method).
     pub reading: Option<Reading>,
+    /// Which of its region's pixels the final joint fit read, for the photo's size (`None`
+    /// for the paper's method).
+    pub pixel_share: Option<PixelShare>,
     /// The water model the lights were fitted with, and why.
     pub water_model: WaterModelUsed,
     /// The photo's water mask (method §5 step 2).
@@ -253,6 +258,7 @@ pub fn fit(
         gloss: found.gloss.0,
         gloss_source: found.gloss.1,
         reading: found.reading,
+        pixel_share: found.reading.map(|r| r.share(photo.len() as u64)),
         water_model,
         water,
         segmentation,
@@ -333,7 +339,7 @@ impl Run<'_> {
             progress: self.progress,
             repeats: j.repeats,
             samples: reading.samples,
-            pixels: reading.share(),
+            pixels: reading.share(self.photo.len() as u64),
             direct_view: j.direct_view,
             ..JointOptions::new(self.paper.model, self.paper.seed)
         }
@@ -413,18 +419,14 @@ impl Run<'_> {
             return Ok(());
         }
         self.progress.stage(&format!(
-            "lights share a streak: joint fit again over {} with {} samples",
-            if reading.all_pixels {
-                "every pixel"
-            } else {
-                "a checkerboard half of the pixels"
-            },
+            "lights share a streak: joint fit again over {} pixels with {} samples",
+            reading.share(self.photo.len() as u64).name(),
             reading.samples
         ));
         let known = std::mem::take(&mut found.splits);
         let refit = JointOptions {
             samples: reading.samples,
-            pixels: reading.share(),
+            pixels: reading.share(self.photo.len() as u64),
             known_splits: &known,
             ..*options
         };

@@ -63,13 +63,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             seed: settings.seed,
             repeats: joint.map_or(1, |j| j.repeats),
             joint_samples: lit.reading.map(|r| effective_samples(r.samples)),
-            joint_pixels: lit.reading.map(|r| {
-                if r.all_pixels {
-                    "all".into()
-                } else {
-                    "checkerboard".into()
-                }
-            }),
+            joint_pixels: lit.pixel_share.map(|s| s.name().into()),
             exposure: run.exposure,
             exposure_source: run.exposure_source,
             nits_scale: run.nits_scale,

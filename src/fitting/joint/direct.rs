@@ -81,7 +81,7 @@ pub(super) fn direct_pixels(
     for y in y0..=y1 {
         for x in x0..=x1 {
             let i = (y * width + x) as usize;
-            if water[i] || !share.reads(x, y) {
+            if water[i] || !share.reads_direct(x, y) {
                 continue;
             }
             let c = ((y - y0) as usize) * cw + (x - x0) as usize;

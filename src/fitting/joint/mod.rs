@@ -134,7 +134,8 @@ mod trace;
 mod uncertainty;
 
 pub use options::{
-    JointOptions, ModelledPixel, PixelShare, StartGate, DEFAULT_JOINT_SAMPLES, MAX_JOINT_SAMPLES,
+    JointOptions, ModelledPixel, PixelShare, StartGate, DEFAULT_JOINT_SAMPLES, LARGE_PHOTO_PIXELS,
+    MAX_JOINT_SAMPLES,
 };
 pub use outcome::JointOutcome;
 pub use proposal::{Lobe, ProposalCache, Reweight, TARGET_OVER_PROPOSAL};

@@ -145,27 +145,60 @@ impl JointOptions<'_> {
     }
 }
 
-/// Which pixels of its region a joint fit reads: the same share of the water pixels and of
-/// the pixels that see a light directly.
+/// Which pixels of its region a joint fit reads, of the water and of the pixels that see a
+/// light directly.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PixelShare {
     /// Every pixel.
     All,
-    /// Every second pixel, on a checkerboard: the fit's default.
+    /// Every second pixel, on a checkerboard: the fit's default on a photo of up to
+    /// [`LARGE_PHOTO_PIXELS`].
     Checkerboard,
-    /// Every fourth pixel, one of each 2 x 2 block (even column, even row): enough for a
-    /// search that compares the costs of fits over the same pixels, where where the minimum
-    /// lies matters and not how well each fit pins its lights.
+    /// One of each 2 x 2 block of the water pixels (even column, even row) and a checkerboard
+    /// of the pixels that see a light directly: the fit's default on a larger photo. There a
+    /// glint covers several pixels, so neighbouring water pixels tell little more than one of
+    /// them, while a direct image's edge is pinned by every row or column it crosses, which a
+    /// checkerboard reads and a quarter does not.
+    QuarterOfWater,
+    /// Every fourth pixel, one of each 2 x 2 block (even column, even row), of the water and of
+    /// the direct view: enough for a search that compares the costs of fits over the same
+    /// pixels, where where the minimum lies matters and not how well each fit pins its lights.
     Quarter,
 }
 
+/// The most pixels of a photo whose joint fit reads a checkerboard of its water pixels by
+/// default; a larger photo's fit reads a quarter of them ([`PixelShare::QuarterOfWater`]).
+/// A 1920 x 1080 photo has 2.07 million.
+pub const LARGE_PHOTO_PIXELS: u64 = 1_000_000;
+
 impl PixelShare {
-    /// Whether the pixel in column `x`, row `y` is read.
+    /// Whether the water pixel in column `x`, row `y` is read.
     pub fn reads(self, x: u32, y: u32) -> bool {
         match self {
             PixelShare::All => true,
             PixelShare::Checkerboard => (x + y).is_multiple_of(2),
-            PixelShare::Quarter => x.is_multiple_of(2) && y.is_multiple_of(2),
+            PixelShare::QuarterOfWater | PixelShare::Quarter => {
+                x.is_multiple_of(2) && y.is_multiple_of(2)
+            }
+        }
+    }
+
+    /// Whether the pixel in column `x`, row `y` is read where it sees a light's wall directly.
+    pub fn reads_direct(self, x: u32, y: u32) -> bool {
+        match self {
+            PixelShare::QuarterOfWater => PixelShare::Checkerboard.reads(x, y),
+            share => share.reads(x, y),
+        }
+    }
+
+    /// The share's name in the report: "all", "checkerboard", "quarter of the water" or
+    /// "quarter".
+    pub fn name(self) -> &'static str {
+        match self {
+            PixelShare::All => "all",
+            PixelShare::Checkerboard => "checkerboard",
+            PixelShare::QuarterOfWater => "quarter of the water",
+            PixelShare::Quarter => "quarter",
         }
     }
 }
@@ -207,6 +240,23 @@ mod tests {
                     .filter(|&&(x, y)| x / 2 == bx && y / 2 == by)
                     .count();
                 assert_eq!(inside, 1, "block ({bx}, {by})");
+            }
+        }
+        // The default share of a large photo reads the quarter's water pixels and the
+        // checkerboard's direct ones.
+        let large = PixelShare::QuarterOfWater;
+        for (x, y) in (0..100u32).flat_map(|y| (0..100u32).map(move |x| (x, y))) {
+            assert_eq!(large.reads(x, y), PixelShare::Quarter.reads(x, y));
+            assert_eq!(
+                large.reads_direct(x, y),
+                PixelShare::Checkerboard.reads(x, y)
+            );
+            for share in [
+                PixelShare::All,
+                PixelShare::Checkerboard,
+                PixelShare::Quarter,
+            ] {
+                assert_eq!(share.reads_direct(x, y), share.reads(x, y));
             }
         }
     }
