@@ -140,7 +140,7 @@ fn other_waves_end_a_gloss_search_at_its_first_fit() {
     use streaklight::fitting::joint::{JointOptions, ModelledPixel, StartGate};
     use streaklight::fitting::FitOptions;
     use streaklight::optics::ReflectionModel;
-    use streaklight::pipeline::fine_structure;
+    use streaklight::pipeline::fine_structure_of;
     let scene = sample_scene("harbour-other-waves.gltf", None);
     let photo = sample_photo("harbour-pair.png");
     let water = water(&scene, &photo);
@@ -149,7 +149,7 @@ fn other_waves_end_a_gloss_search_at_its_first_fit() {
     let asked = std::sync::atomic::AtomicUsize::new(0);
     let gate = |image: &[ModelledPixel]| {
         asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        !fine_structure(&photo.radiance, photo.width, image).is_some_and(|f| f.clearly_not_exact())
+        !fine_structure_of(&photo, scene.camera.yfov, image).is_some_and(|f| f.clearly_not_exact())
     };
     let estimate = estimate_gloss(
         &scene,
@@ -171,7 +171,7 @@ fn other_waves_end_a_gloss_search_at_its_first_fit() {
     assert!(estimate.stopped_at_start);
     assert_eq!(asked.into_inner(), 1);
     assert!(estimate.lights.is_empty() && estimate.evaluations.is_empty());
-    let start = fine_structure(&photo.radiance, photo.width, &estimate.modelled).unwrap();
+    let start = fine_structure_of(&photo, scene.camera.yfov, &estimate.modelled).unwrap();
     assert!(start.correlation.unwrap().abs() < 0.15, "{start:?}");
 }
 

@@ -681,7 +681,7 @@ fn a_known_split_is_tried_only_its_way() {
 /// photo than the paper's. A gate that lets the fit go on changes nothing of it.
 #[test]
 fn a_start_gate_ends_the_fit_before_its_descent() {
-    use streaklight::pipeline::fine_structure;
+    use streaklight::pipeline::fine_structure_of;
     let start = paper_start("table1.png");
     let fit = |gate: Option<StartGate<'_>>| {
         start.fit(|o| JointOptions {
@@ -712,7 +712,7 @@ fn a_start_gate_ends_the_fit_before_its_descent() {
     let ids = |m: &[(u32, [f32; 3])]| m.iter().map(|p| p.0).collect::<Vec<_>>();
     assert_eq!(ids(&shown), ids(&plain.modelled));
     let explained = |m: &[(u32, [f32; 3])]| {
-        fine_structure(&start.photo.radiance, start.photo.width, m)
+        fine_structure_of(&start.photo, start.scene.camera.yfov, m)
             .and_then(|f| f.explained)
             .unwrap()
     };

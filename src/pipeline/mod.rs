@@ -19,8 +19,8 @@ use std::time::Instant;
 pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
 pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
 pub use water_choice::{
-    fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_CORRELATION,
-    EXACT_MIN_EXPLAINED, FLAT_SHARE, START_MAX_CORRELATION,
+    fine_structure, fine_structure_of, high_pass_radius, FineStructure, SlopesUsed, WaterChoice,
+    WaterModelUsed, EXACT_MIN_CORRELATION, EXACT_MIN_EXPLAINED, FLAT_SHARE, START_MAX_CORRELATION,
 };
 
 use crate::background::{self, Background};

@@ -18,11 +18,33 @@
 //! model at once, so that the slopes are estimated from the photo (a game scene's quad
 //! carries a roughness that is a guess) and no exact fit is spent on the test.
 
+use rayon::prelude::*;
 use serde::Serialize;
 
-/// Half the side of the window whose mean is subtracted, in pixels: a few pixels, the scale
-/// of a glint, far below a streak's.
+use crate::photo_in::Photo;
+
+/// Half the side of the window whose mean is subtracted, in pixels, on a photo of
+/// [`HIGH_PASS_ROWS_PER_DEGREE`]: a few pixels, the scale of a glint, far below a streak's.
 pub const HIGH_PASS_RADIUS: i64 = 3;
+
+/// The photo's rows per degree of the camera's vertical field of view at which
+/// [`HIGH_PASS_RADIUS`] holds: the samples' 600 rows over 60 degrees, on which the thresholds
+/// below were measured.
+pub const HIGH_PASS_ROWS_PER_DEGREE: f64 = 10.0;
+
+/// The high-pass window's half side on a photo of `rows` rows through a vertical field of
+/// view of `yfov` radians: [`HIGH_PASS_RADIUS`] grown with the rows per degree, never below
+/// it. A glint covers the same angle at any resolution, so on a finer photo it spans more
+/// pixels, and a window of the samples' pixels would pass the glint's inside alone (on
+/// Table 1 rendered at 4000 x 3000, its own waves correlated at 0.03).
+pub fn high_pass_radius(rows: u32, yfov: f32) -> i64 {
+    let per_degree = rows as f64 / (yfov as f64).to_degrees();
+    if !per_degree.is_finite() {
+        return HIGH_PASS_RADIUS;
+    }
+    let scaled = (HIGH_PASS_RADIUS as f64 * per_degree / HIGH_PASS_ROWS_PER_DEGREE).round();
+    HIGH_PASS_RADIUS.max(scaled.min(1000.0) as i64)
+}
 
 /// The correlation of the high-passed photo and exact expected image below which the
 /// scene's waves are taken not to be the photo's.
@@ -148,12 +170,25 @@ impl FineStructure {
     }
 }
 
-/// The fine structure of `photo` and of the model `modelled` (see [`FineStructure`]); `None`
-/// with fewer than 16 pixels.
+/// The fine structure of `photo` (seen through a vertical field of view of `yfov` radians)
+/// and of the model `modelled`, high-passed at [`high_pass_radius`].
+pub fn fine_structure_of(
+    photo: &Photo,
+    yfov: f32,
+    modelled: &[(u32, [f32; 3])],
+) -> Option<FineStructure> {
+    let radius = high_pass_radius(photo.height, yfov);
+    fine_structure(&photo.radiance, photo.width, modelled, radius)
+}
+
+/// The fine structure of `photo` and of the model `modelled` (see [`FineStructure`]), each
+/// value less the mean of the fitted pixels within `radius` of it; `None` with fewer than 16
+/// pixels.
 pub fn fine_structure(
     photo: &[[f32; 3]],
     width: u32,
     modelled: &[(u32, [f32; 3])],
+    radius: i64,
 ) -> Option<FineStructure> {
     if modelled.len() < 16 || width == 0 {
         return None;
@@ -185,27 +220,33 @@ pub fn fine_structure(
         .zip(&model_value)
         .map(|(p, m)| (p - m).powi(2))
         .sum();
-    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
-    let r = HIGH_PASS_RADIUS;
-    for (i, &(p, _)) in modelled.iter().enumerate() {
-        let (x, y) = (p as i64 % w, p as i64 / w);
-        let (mut mp, mut mm, mut n) = (0.0, 0.0, 0.0);
-        for dy in -r..=r {
-            for dx in -r..=r {
-                let (nx, ny) = (x + dx, y + dy);
-                if nx < x0 || nx > x1 || ny < y0 || ny > y1 {
-                    continue;
-                }
-                let j = index[((ny - y0) * box_width + nx - x0) as usize];
-                if j != usize::MAX {
-                    mp += photo_value[j];
-                    mm += model_value[j];
-                    n += 1.0;
+    let r = radius.max(1);
+    // Each pixel's high-passed pair, in parallel (the window of a fine photo reads hundreds
+    // of neighbours), summed in order below.
+    let passed: Vec<(f64, f64)> = (0..modelled.len())
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (modelled[i].0 as i64 % w, modelled[i].0 as i64 / w);
+            let (mut mp, mut mm, mut n) = (0.0, 0.0, 0.0);
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if nx < x0 || nx > x1 || ny < y0 || ny > y1 {
+                        continue;
+                    }
+                    let j = index[((ny - y0) * box_width + nx - x0) as usize];
+                    if j != usize::MAX {
+                        mp += photo_value[j];
+                        mm += model_value[j];
+                        n += 1.0;
+                    }
                 }
             }
-        }
-        let hp = photo_value[i] - mp / n;
-        let hm = model_value[i] - mm / n;
+            (photo_value[i] - mp / n, model_value[i] - mm / n)
+        })
+        .collect();
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    for (hp, hm) in passed {
         sxx += hp * hp;
         syy += hm * hm;
         sxy += hp * hm;
@@ -219,6 +260,20 @@ pub fn fine_structure(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The window grows with the rows per degree: the samples' 600 rows over 60 degrees keep
+    /// 3 pixels, 1080 rows 5.4 (5), 3000 rows 15; a coarser photo or a wider view keeps 3, and
+    /// a degenerate field of view does not break it.
+    #[test]
+    fn the_high_pass_window_follows_the_rows_per_degree() {
+        let sixty = 60f32.to_radians();
+        assert_eq!(high_pass_radius(600, sixty), 3);
+        assert_eq!(high_pass_radius(1080, sixty), 5);
+        assert_eq!(high_pass_radius(3000, sixty), 15);
+        assert_eq!(high_pass_radius(2000, 2.0 * sixty), 5);
+        assert_eq!(high_pass_radius(300, sixty), 3);
+        assert_eq!(high_pass_radius(600, 0.0), 3);
+    }
 
     /// A smooth streak with glints: the correlation of the photo with itself is 1, with the
     /// smooth streak alone (no fine structure to match) near 0, and with glints elsewhere
@@ -255,7 +310,7 @@ mod tests {
             region.iter().map(|&p| (p, img[p as usize])).collect()
         };
         let correlation = |img: &[[f32; 3]]| {
-            fine_structure(&photo, w, &as_model(img))
+            fine_structure(&photo, w, &as_model(img), HIGH_PASS_RADIUS)
                 .unwrap()
                 .correlation
         };
@@ -268,7 +323,7 @@ mod tests {
         // The same glints under a wider smooth streak still match.
         let wider = correlation(&image(9.0, Some(1)));
         assert!(wider.unwrap() > 0.8, "{wider:?}");
-        assert_eq!(fine_structure(&photo, w, &[]), None);
+        assert_eq!(fine_structure(&photo, w, &[], HIGH_PASS_RADIUS), None);
         // A smooth photo explained by a smooth model: nothing to correlate, and the exact
         // model fits all the same; a glittering photo against a smooth model does not.
         let smooth = image(6.0, None);
@@ -277,7 +332,7 @@ mod tests {
             .zip(image(6.0, Some(99)))
             .map(|(s, g)| [s[0] + 0.03 * (g[0] - s[0]); 3])
             .collect();
-        let f = fine_structure(&smooth, w, &as_model(&faint_glints)).unwrap();
+        let f = fine_structure(&smooth, w, &as_model(&faint_glints), HIGH_PASS_RADIUS).unwrap();
         assert!(f.explained.unwrap() > 0.95 && f.exact_fits(), "{f:?}");
         // The rule: either test keeps the exact model.
         let rule = |c, e| {
@@ -305,7 +360,7 @@ mod tests {
                 assert!(!skip(Some(c), Some(e)) || !rule(c, e), "{c} {e}");
             }
         }
-        let f = fine_structure(&photo, w, &as_model(&image(9.0, None))).unwrap();
+        let f = fine_structure(&photo, w, &as_model(&image(9.0, None)), HIGH_PASS_RADIUS).unwrap();
         assert!(f.explained.unwrap() < 0.9 && !f.exact_fits(), "{f:?}");
     }
 }

@@ -3,7 +3,7 @@
 //! doc).
 
 use super::water_choice::{
-    fine_structure, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_EXPLAINED,
+    fine_structure_of, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_EXPLAINED,
     FLAT_SHARE, START_MAX_CORRELATION,
 };
 use super::{Found, GlossFit, Method, Run, EXACT_MIN_CORRELATION};
@@ -58,7 +58,7 @@ impl Run<'_> {
             (WaterChoice::Exact, method) => {
                 self.exact(method, found, None)?;
                 // Measured all the same, for the report.
-                let fine = fine_structure(&self.photo.radiance, self.photo.width, &found.modelled);
+                let fine = fine_structure_of(self.photo, self.scene.camera.yfov, &found.modelled);
                 Ok(WaterModelUsed {
                     fine_structure_correlation: fine.and_then(|f| f.correlation),
                     exact_explained: fine.and_then(|f| f.explained),
@@ -90,10 +90,9 @@ impl Run<'_> {
                 // then the test on its expected image: where it passes, nothing is done twice.
                 // Where the start lights' expected image already shows fine structure
                 // unrelated to the photo's, the fit ends there (`clearly_not_exact`).
-                let photo = self.photo;
+                let (photo, yfov) = (self.photo, self.scene.camera.yfov);
                 let gate = |modelled: &[ModelledPixel]| {
-                    !fine_structure(&photo.radiance, photo.width, modelled)
-                        .is_some_and(|f| f.clearly_not_exact())
+                    !fine_structure_of(photo, yfov, modelled).is_some_and(|f| f.clearly_not_exact())
                 };
                 self.exact(method, found, Some(StartGate(&gate)))?;
                 if found.lights.is_empty() && !found.stopped_at_start {
@@ -103,7 +102,7 @@ impl Run<'_> {
                         ..WaterModelUsed::forced("exact")
                     });
                 }
-                let fine = fine_structure(&self.photo.radiance, self.photo.width, &found.modelled);
+                let fine = fine_structure_of(self.photo, self.scene.camera.yfov, &found.modelled);
                 let correlation = fine.and_then(|f| f.correlation);
                 let exact_explained = fine.and_then(|f| f.explained);
                 if fine.is_none_or(|f| f.exact_fits()) {
