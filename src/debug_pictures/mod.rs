@@ -131,7 +131,7 @@ pub const FIT_PICTURE: &str = "fit-photo-render-difference.png";
 /// The file name of the page showing the pictures.
 pub const INDEX: &str = "index.html";
 
-/// Every file [`write`] writes into its folder.
+/// Every file [`write()`] writes into its folder.
 pub fn file_names() -> Vec<&'static str> {
     let mut names = streaks::pictures::PICTURE_NAMES.to_vec();
     names.extend([

@@ -3,7 +3,7 @@
 //! merged and the union is fitted again.
 //!
 //! [`group`] decides which streaks are one light, and the joint fit's start merges lights
-//! that start on one lamp's direct image ([`super::joint::direct_start`]): `fit` fits the
+//! that start on one lamp's direct image (`joint::direct_start`): `fit` fits the
 //! groups ([`super::fit_paper_with`]) and starts its joint fit from them, and `segment`
 //! reports the streaks of the same lights ([`lights`]).
 
@@ -103,7 +103,7 @@ pub fn group(
 /// The streaks of each light `fit` fits from `streaks` (by their ids, sorted; in the order of
 /// the lights): the fragments [`group`] puts together, with the groups whose lights start on
 /// one lamp's direct image merged, as the joint fit's start merges them
-/// ([`super::joint::direct_start::direct_starts`]). Streaks that give no light are in no
+/// (`joint::direct_start::direct_starts`). Streaks that give no light are in no
 /// group ([`Grouping::skipped`] says why).
 pub fn lights(
     water_model: &dyn WaterModel,

@@ -126,7 +126,7 @@ impl LightPlane {
     }
 
     /// True when two planes are one plane, whatever faces they came from: parallel, and
-    /// each point within [`plane_tolerance`] of the other plane.
+    /// each point within `plane_tolerance` of the other plane.
     pub fn same_plane(&self, other: &LightPlane) -> bool {
         self.normal.dot(other.normal) > 1.0 - COPLANAR_COS
             && (other.point - self.point).dot(self.normal).abs()

@@ -18,7 +18,7 @@ pub struct Refusal {
     pub report_version: u32,
     /// streaklight's version.
     pub tool_version: String,
-    /// Always [`REFUSED`].
+    /// Always `REFUSED`.
     pub status: String,
     /// Why, as the error message says it.
     pub error: String,

@@ -10,7 +10,7 @@
 //! Fragments are not merged by the extraction: two fragments of one light (a wave breaking a
 //! streak) are told apart from two lights only by where their lights land in the scene, which
 //! the fitter knows (method §5 step 5, [`crate::fitting::fragments::group`]);
-//! [`Segmentation::merged`] then makes each group one streak ([`merge`]).
+//! [`Segmentation::merged`] then makes each group one streak (`merge`).
 
 pub mod edges;
 pub mod growing;

@@ -21,7 +21,7 @@ pub struct Uncertainty {
     /// (their sigmas say how well).
     pub direct_pixels: usize,
     /// Whether a fitted pixel sees the light whole in a channel the photo did not clip, so
-    /// that its radiance is read off its image ([`Problem::sees_radiance`]); otherwise the
+    /// that its radiance is read off its image (`Problem::sees_radiance`); otherwise the
     /// reflections alone give it.
     pub radiance_seen: bool,
     /// Per edge, the largest one-sigma error the light's direct image leaves it, metres
