@@ -50,7 +50,7 @@ fn a_photo_of_two_megapixels_reads_a_quarter_of_its_water() {
 
     assert_eq!(
         report.settings.joint_pixels.as_deref(),
-        Some("quarter of the water")
+        Some("one water pixel of each 2 x 2 block")
     );
     // The photo is of the scene's own waves: its glints, wider in pixels than at 600 rows,
     // match the exact model's through the high-pass window grown with the rows per degree as

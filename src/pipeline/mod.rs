@@ -21,7 +21,7 @@ pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROU
 pub use water_choice::{
     fine_structure, fine_structure_of, high_pass_radius, FineStructure, SlopesUsed, WaterChoice,
     WaterModelUsed, EXACT_MIN_CORRELATION, EXACT_MIN_EXPLAINED, FLAT_SHARE, HIGH_PASS_RADIUS,
-    HIGH_PASS_ROWS_PER_DEGREE, START_MAX_CORRELATION,
+    START_MAX_CORRELATION,
 };
 
 use crate::background::{self, Background};

@@ -4,7 +4,7 @@
 
 use super::water_choice::WaterChoice;
 use crate::fitting::gloss::{GlossSearch, SEARCH_SAMPLES};
-use crate::fitting::joint::{PixelShare, DEFAULT_JOINT_SAMPLES, LARGE_PHOTO_PIXELS};
+use crate::fitting::joint::{PixelShare, DEFAULT_JOINT_SAMPLES};
 use crate::fitting::DEFAULT_SAMPLES;
 use crate::optics::Shadowing;
 use crate::settings::Setting;
@@ -85,9 +85,10 @@ pub struct Reading {
     /// [`crate::fitting::joint::effective_samples`]). The time grows with them and the fit's
     /// own noise falls.
     pub samples: u32,
-    /// Every pixel of the fitted region instead of a checkerboard half (a quarter of the
-    /// water pixels on a photo of more than [`LARGE_PHOTO_PIXELS`]): about twice the time (four
-    /// times), less of both the samples' and the photo's noise.
+    /// Every pixel of the fitted region instead of a checkerboard half (one water pixel of
+    /// each block on a photo of more than a megapixel, [`PixelShare::water_blocks`]):
+    /// about twice the time (four times or more), less of both the samples' and the photo's
+    /// noise.
     pub all_pixels: bool,
 }
 
@@ -96,10 +97,8 @@ impl Reading {
     pub fn share(&self, photo_pixels: u64) -> PixelShare {
         if self.all_pixels {
             PixelShare::All
-        } else if photo_pixels > LARGE_PHOTO_PIXELS {
-            PixelShare::QuarterOfWater
         } else {
-            PixelShare::Checkerboard
+            PixelShare::water_blocks(photo_pixels)
         }
     }
 }
@@ -219,15 +218,16 @@ impl FitSettings {
 mod tests {
     use super::*;
 
-    /// A photo up to a megapixel reads a checkerboard, a larger one a quarter of its water,
-    /// and `all_pixels` every pixel at any size.
+    /// A photo up to a megapixel reads a checkerboard, a larger one one water pixel of each
+    /// block, and `all_pixels` every pixel at any size.
     #[test]
     fn the_share_follows_the_photo_size() {
         let default = JointSettings::default().reading;
         assert_eq!(default.share(600 * 600), PixelShare::Checkerboard);
         assert_eq!(default.share(1000 * 1000), PixelShare::Checkerboard);
-        assert_eq!(default.share(1000 * 1000 + 1), PixelShare::QuarterOfWater);
-        assert_eq!(default.share(1920 * 1080), PixelShare::QuarterOfWater);
+        assert_eq!(default.share(1000 * 1000 + 1), PixelShare::WaterBlocks(2));
+        assert_eq!(default.share(1920 * 1080), PixelShare::WaterBlocks(2));
+        assert_eq!(default.share(4000 * 3000), PixelShare::WaterBlocks(4));
         for size in [600 * 600, 1920 * 1080] {
             assert_eq!(THOROUGH.share(size), PixelShare::All);
         }

@@ -22,28 +22,20 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::photo_in::Photo;
+use crate::pixel_scale::scaled_pixels;
 
-/// Half the side of the window whose mean is subtracted, in pixels, on a photo of
-/// [`HIGH_PASS_ROWS_PER_DEGREE`]: a few pixels, the scale of a glint, far below a streak's.
+/// Half the side of the window whose mean is subtracted, in pixels, on the samples' photos:
+/// a few pixels, the scale of a glint, far below a streak's ([`high_pass_radius`] on
+/// others).
 pub const HIGH_PASS_RADIUS: i64 = 3;
 
-/// The photo's rows per degree of the camera's vertical field of view at which
-/// [`HIGH_PASS_RADIUS`] holds: the samples' 600 rows over 60 degrees, on which the thresholds
-/// below were measured.
-pub const HIGH_PASS_ROWS_PER_DEGREE: f64 = 10.0;
-
 /// The high-pass window's half side on a photo of `rows` rows through a vertical field of
-/// view of `yfov` radians: [`HIGH_PASS_RADIUS`] grown with the rows per degree, never below
-/// it. A glint covers the same angle at any resolution, so on a finer photo it spans more
-/// pixels, and a window of the samples' pixels would pass the glint's inside alone (on
-/// Table 1 rendered at 4000 x 3000, its own waves correlated at 0.03).
+/// view of `yfov` radians: [`HIGH_PASS_RADIUS`] grown with the rows per degree
+/// ([`crate::pixel_scale`]), where the thresholds below were measured. A window of the
+/// samples' pixels would pass a finer photo's glints' inside alone (on Table 1 rendered at
+/// 4000 x 3000, its own waves correlated at 0.03).
 pub fn high_pass_radius(rows: u32, yfov: f32) -> i64 {
-    let per_degree = rows as f64 / (yfov as f64).to_degrees();
-    if !per_degree.is_finite() {
-        return HIGH_PASS_RADIUS;
-    }
-    let scaled = (HIGH_PASS_RADIUS as f64 * per_degree / HIGH_PASS_ROWS_PER_DEGREE).round();
-    HIGH_PASS_RADIUS.max(scaled.min(1000.0) as i64)
+    scaled_pixels(HIGH_PASS_RADIUS, rows, yfov)
 }
 
 /// The correlation of the high-passed photo and exact expected image below which the
@@ -261,18 +253,13 @@ pub fn fine_structure(
 mod tests {
     use super::*;
 
-    /// The window grows with the rows per degree: the samples' 600 rows over 60 degrees keep
-    /// 3 pixels, 1080 rows 5.4 (5), 3000 rows 15; a coarser photo or a wider view keeps 3, and
-    /// a degenerate field of view does not break it.
+    /// The window is the samples' 3 pixels grown with the rows per degree: 5 at 1080 rows
+    /// over 60 degrees.
     #[test]
     fn the_high_pass_window_follows_the_rows_per_degree() {
         let sixty = 60f32.to_radians();
-        assert_eq!(high_pass_radius(600, sixty), 3);
+        assert_eq!(high_pass_radius(600, sixty), HIGH_PASS_RADIUS);
         assert_eq!(high_pass_radius(1080, sixty), 5);
-        assert_eq!(high_pass_radius(3000, sixty), 15);
-        assert_eq!(high_pass_radius(2000, 2.0 * sixty), 5);
-        assert_eq!(high_pass_radius(300, sixty), 3);
-        assert_eq!(high_pass_radius(600, 0.0), 3);
     }
 
     /// A smooth streak with glints: the correlation of the photo with itself is 1, with the

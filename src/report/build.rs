@@ -4,7 +4,7 @@ use super::{
     light_warnings, BackgroundReport, EdgeReport, EdgesReport, Files, LightReport, PlaneReport,
     Report, Settings, SkippedStreak, Timing, UncertaintyReport, REPORT_VERSION,
 };
-use crate::fitting::joint::{effective_samples, Uncertainty};
+use crate::fitting::joint::{effective_samples, PixelShare, Uncertainty};
 use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, Skipped};
 use crate::optics::Shadowing;
 use crate::pipeline::{light_name, FitSettings, Lit, Method};
@@ -63,7 +63,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
             seed: settings.seed,
             repeats: joint.map_or(1, |j| j.repeats),
             joint_samples: lit.reading.map(|r| effective_samples(r.samples)),
-            joint_pixels: lit.pixel_share.map(|s| s.name().into()),
+            joint_pixels: lit.pixel_share.map(PixelShare::name),
             exposure: run.exposure,
             exposure_source: run.exposure_source,
             nits_scale: run.nits_scale,

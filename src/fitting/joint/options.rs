@@ -154,12 +154,14 @@ pub enum PixelShare {
     /// Every second pixel, on a checkerboard: the fit's default on a photo of up to
     /// [`LARGE_PHOTO_PIXELS`].
     Checkerboard,
-    /// One of each 2 x 2 block of the water pixels (even column, even row) and a checkerboard
-    /// of the pixels that see a light directly: the fit's default on a larger photo. There a
-    /// glint covers several pixels, so neighbouring water pixels tell little more than one of
-    /// them, while a direct image's edge is pinned by every row or column it crosses, which a
-    /// checkerboard reads and a quarter does not.
-    QuarterOfWater,
+    /// One water pixel of each `b` x `b` block (column and row multiples of `b`) and a
+    /// checkerboard of the pixels that see a light directly: the fit's default on a photo of
+    /// more than [`LARGE_PHOTO_PIXELS`], `b` growing with its size
+    /// ([`PixelShare::water_blocks`]). There a glint covers several pixels, so neighbouring
+    /// water pixels tell little more than one of them, while a direct image's edge is pinned
+    /// by every row or column it crosses, which a checkerboard reads and a block grid does
+    /// not.
+    WaterBlocks(u32),
     /// Every fourth pixel, one of each 2 x 2 block (even column, even row), of the water and of
     /// the direct view: enough for a search that compares the costs of fits over the same
     /// pixels, where where the minimum lies matters and not how well each fit pins its lights.
@@ -167,38 +169,70 @@ pub enum PixelShare {
 }
 
 /// The most pixels of a photo whose joint fit reads a checkerboard of its water pixels by
-/// default; a larger photo's fit reads a quarter of them ([`PixelShare::QuarterOfWater`]).
-/// A 1920 x 1080 photo has 2.07 million.
+/// default; a larger photo's fit reads one of each block of them
+/// ([`PixelShare::WaterBlocks`]), so that the water pixels read grow no faster than
+/// [`LARGE_PHOTO_PIXELS`] over 4. A 1920 x 1080 photo has 2.07 million.
 pub const LARGE_PHOTO_PIXELS: u64 = 1_000_000;
 
 impl PixelShare {
+    /// The default share of the water of a photo of `pixels` pixels: a checkerboard up to
+    /// [`LARGE_PHOTO_PIXELS`], else one of each `b` x `b` block with `b` the least for which
+    /// `b^2` such photos hold the photo (2 up to 4 million pixels, 4 from 9 to 16 million).
+    pub fn water_blocks(pixels: u64) -> PixelShare {
+        if pixels <= LARGE_PHOTO_PIXELS {
+            return PixelShare::Checkerboard;
+        }
+        let mut b = 2u32;
+        while u64::from(b) * u64::from(b) * LARGE_PHOTO_PIXELS < pixels {
+            b += 1;
+        }
+        PixelShare::WaterBlocks(b)
+    }
+
     /// Whether the water pixel in column `x`, row `y` is read.
     pub fn reads(self, x: u32, y: u32) -> bool {
         match self {
             PixelShare::All => true,
             PixelShare::Checkerboard => (x + y).is_multiple_of(2),
-            PixelShare::QuarterOfWater | PixelShare::Quarter => {
-                x.is_multiple_of(2) && y.is_multiple_of(2)
+            PixelShare::WaterBlocks(b) => {
+                let b = b.max(1);
+                x.is_multiple_of(b) && y.is_multiple_of(b)
             }
+            PixelShare::Quarter => x.is_multiple_of(2) && y.is_multiple_of(2),
+        }
+    }
+
+    /// Whether two water pixels this share reads can lie `dx` columns and `dy` rows apart:
+    /// the pixels read form a lattice through the origin, so a lag between two of them is
+    /// itself on it.
+    pub fn lag_between_read(self, dx: i64, dy: i64) -> bool {
+        match self {
+            PixelShare::All => true,
+            PixelShare::Checkerboard => (dx + dy).rem_euclid(2) == 0,
+            PixelShare::WaterBlocks(b) => {
+                let b = i64::from(b.max(1));
+                dx.rem_euclid(b) == 0 && dy.rem_euclid(b) == 0
+            }
+            PixelShare::Quarter => dx.rem_euclid(2) == 0 && dy.rem_euclid(2) == 0,
         }
     }
 
     /// Whether the pixel in column `x`, row `y` is read where it sees a light's wall directly.
     pub fn reads_direct(self, x: u32, y: u32) -> bool {
         match self {
-            PixelShare::QuarterOfWater => PixelShare::Checkerboard.reads(x, y),
+            PixelShare::WaterBlocks(_) => PixelShare::Checkerboard.reads(x, y),
             share => share.reads(x, y),
         }
     }
 
-    /// The share's name in the report: "all", "checkerboard", "quarter of the water" or
-    /// "quarter".
-    pub fn name(self) -> &'static str {
+    /// The share's name in the report: "all", "checkerboard", "one water pixel of each
+    /// B x B block" or "quarter".
+    pub fn name(self) -> String {
         match self {
-            PixelShare::All => "all",
-            PixelShare::Checkerboard => "checkerboard",
-            PixelShare::QuarterOfWater => "quarter of the water",
-            PixelShare::Quarter => "quarter",
+            PixelShare::All => "all".into(),
+            PixelShare::Checkerboard => "checkerboard".into(),
+            PixelShare::WaterBlocks(b) => format!("one water pixel of each {b} x {b} block"),
+            PixelShare::Quarter => "quarter".into(),
         }
     }
 }
@@ -242,9 +276,9 @@ mod tests {
                 assert_eq!(inside, 1, "block ({bx}, {by})");
             }
         }
-        // The default share of a large photo reads the quarter's water pixels and the
+        // The default share of a large photo reads one water pixel of each block and the
         // checkerboard's direct ones.
-        let large = PixelShare::QuarterOfWater;
+        let large = PixelShare::WaterBlocks(2);
         for (x, y) in (0..100u32).flat_map(|y| (0..100u32).map(move |x| (x, y))) {
             assert_eq!(large.reads(x, y), PixelShare::Quarter.reads(x, y));
             assert_eq!(
@@ -259,5 +293,39 @@ mod tests {
                 assert_eq!(share.reads_direct(x, y), share.reads(x, y));
             }
         }
+        // The lags between two pixels read are the lags the share allows.
+        for share in [
+            PixelShare::All,
+            PixelShare::Checkerboard,
+            PixelShare::Quarter,
+            PixelShare::WaterBlocks(3),
+        ] {
+            let pixels = read(share);
+            for (dx, dy) in (-6i64..=6).flat_map(|dy| (-6i64..=6).map(move |dx| (dx, dy))) {
+                let (x, y) = (pixels[0].0 as i64 + 12, pixels[0].1 as i64 + 12);
+                let (from, to) = ((x as u32, y as u32), ((x + dx) as u32, (y + dy) as u32));
+                let both = share.reads(from.0, from.1) && share.reads(to.0, to.1);
+                if share.reads(from.0, from.1) {
+                    assert_eq!(share.lag_between_read(dx, dy), both, "{share:?} {dx} {dy}");
+                }
+            }
+        }
+        let blocks = read(PixelShare::WaterBlocks(4));
+        assert_eq!(blocks.len(), 625);
+        assert!(blocks.iter().all(|&(x, y)| x % 4 == 0 && y % 4 == 0));
+    }
+
+    /// The block's side is the least `b` with `b^2` megapixels holding the photo.
+    #[test]
+    fn the_water_blocks_grow_with_the_photo() {
+        let share = PixelShare::water_blocks;
+        assert_eq!(share(600 * 600), PixelShare::Checkerboard);
+        assert_eq!(share(1_000_000), PixelShare::Checkerboard);
+        assert_eq!(share(1_000_001), PixelShare::WaterBlocks(2));
+        assert_eq!(share(1920 * 1080), PixelShare::WaterBlocks(2));
+        assert_eq!(share(4_000_000), PixelShare::WaterBlocks(2));
+        assert_eq!(share(4_000_001), PixelShare::WaterBlocks(3));
+        assert_eq!(share(4000 * 3000), PixelShare::WaterBlocks(4));
+        assert_eq!(share(8192 * 5464), PixelShare::WaterBlocks(7));
     }
 }

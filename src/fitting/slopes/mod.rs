@@ -55,6 +55,7 @@ use super::joint::{
 use super::{fit_paper_with, FitOptions, FittedLight, Rect, Skipped, StreakObservation};
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::photo_in::Photo;
+use crate::pixel_scale::scaled_pixels;
 use crate::scene_in::Scene;
 use crate::water_model::{MeanSurface, StatisticalSurface};
 use crate::Result;
@@ -384,7 +385,13 @@ pub fn estimate_slopes(
     )?;
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
     warnings.extend(fit.warnings.iter().cloned());
-    let area = correlation_area(&photo.radiance, photo.width, &fit.modelled);
+    let area = correlation_area(
+        &photo.radiance,
+        photo.width,
+        &fit.modelled,
+        scaled_pixels(MAX_LAG, photo.height, scene.camera.yfov),
+        final_fit.pixels,
+    );
     let sigma_ln = sigma_ln.map(|s| s.map(|s| s * area.sqrt() as f32));
     let lights = fit.lights_with_statuses();
     let mut uncertainty = fit.uncertainty;

@@ -14,22 +14,31 @@
 //! least-squares line through the search's last pass on that axis, every fit of which
 //! re-optimised the lights) times that variance's uncertainty is added in quadrature.
 
-use std::collections::HashMap;
+use rayon::prelude::*;
 
-use crate::fitting::joint::Uncertainty;
+use crate::fitting::joint::{PixelShare, Uncertainty};
 use crate::fitting::EdgeSide;
 use crate::fitting::FittedLight;
 
-/// The largest lag, in pixels along each axis, of the residual's correlation area.
+/// The largest lag, in pixels along each axis, of the residual's correlation area on the
+/// samples' photos; on a finer photo it grows with the rows per degree
+/// ([`crate::pixel_scale`]), so that it spans the same angle.
 pub const MAX_LAG: i64 = 8;
 
-/// The residual's correlation area, in pixels: the sum of its autocorrelation over lags
-/// within `MAX_LAG` each way (lag 0 counts 1), over the fitted pixels `modelled` of a
-/// `width`-wide `photo` (sum of channels); at least 1.
-pub fn correlation_area(photo: &[[f32; 3]], width: u32, modelled: &[(u32, [f32; 3])]) -> f64 {
+/// The residual's correlation area, in pixels read: the sum of its autocorrelation over lags
+/// within `max_lag` each way (lag 0 counts 1), over the fitted pixels `modelled` of a
+/// `width`-wide `photo` (sum of channels), read as `share` reads the water; at least 1. A lag
+/// between two pixels of the share is on its lattice, so only those lags are summed.
+pub fn correlation_area(
+    photo: &[[f32; 3]],
+    width: u32,
+    modelled: &[(u32, [f32; 3])],
+    max_lag: i64,
+    share: PixelShare,
+) -> f64 {
     let w = width as i64;
-    // In the order given, so that every sum is taken in one order (determinism); the map only
-    // finds a pixel's neighbours.
+    // In the order given, so that every sum is taken in one order (determinism); the grid
+    // only finds a pixel's neighbours.
     let residual: Vec<(i64, f64)> = modelled
         .iter()
         .map(|&(p, m)| {
@@ -41,34 +50,50 @@ pub fn correlation_area(photo: &[[f32; 3]], width: u32, modelled: &[(u32, [f32; 
     if residual.len() < 2 || w == 0 {
         return 1.0;
     }
-    let at: HashMap<i64, f64> = residual.iter().copied().collect();
     let n_all = residual.len() as f64;
     let mean = residual.iter().map(|r| r.1).sum::<f64>() / n_all;
     let var = residual.iter().map(|r| (r.1 - mean).powi(2)).sum::<f64>() / n_all;
     if var <= 0.0 {
         return 1.0;
     }
-    let mut area = 0.0;
-    for dy in -MAX_LAG..=MAX_LAG {
-        for dx in -MAX_LAG..=MAX_LAG {
+    // The residual on the fitted pixels' bounding box, NaN where no pixel was fitted.
+    let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
+    for &(p, _) in &residual {
+        let (x, y) = (p % w, p / w);
+        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+    }
+    let box_width = x1 - x0 + 1;
+    let mut grid = vec![f64::NAN; (box_width * (y1 - y0 + 1)) as usize];
+    for &(p, r) in &residual {
+        grid[((p / w - y0) * box_width + p % w - x0) as usize] = r;
+    }
+    let lags: Vec<(i64, i64)> = (-max_lag..=max_lag)
+        .flat_map(|dy| (-max_lag..=max_lag).map(move |dx| (dx, dy)))
+        .filter(|&(dx, dy)| share.lag_between_read(dx, dy))
+        .collect();
+    let by_lag: Vec<f64> = lags
+        .par_iter()
+        .map(|&(dx, dy)| {
             let (mut sum, mut n) = (0.0, 0usize);
             for &(p, r) in &residual {
-                let (x, y) = (p % w, p / w);
-                let (qx, qy) = (x + dx, y + dy);
-                if qx < 0 || qx >= w || qy < 0 {
+                let (qx, qy) = (p % w + dx, p / w + dy);
+                if qx < x0 || qx > x1 || qy < y0 || qy > y1 {
                     continue;
                 }
-                if let Some(&s) = at.get(&(qy * w + qx)) {
+                let s = grid[((qy - y0) * box_width + qx - x0) as usize];
+                if !s.is_nan() {
                     sum += (r - mean) * (s - mean);
                     n += 1;
                 }
             }
             if n > 0 {
-                area += sum / n as f64 / var;
+                sum / n as f64 / var
+            } else {
+                0.0
             }
-        }
-    }
-    area.max(1.0)
+        })
+        .collect();
+    by_lag.iter().sum::<f64>().max(1.0)
 }
 
 /// The relative uncertainty, at least, of a radiance the reflections alone give under the
@@ -204,8 +229,8 @@ mod tests {
             .map(|p| [noise[((p % w) / 2 + w * ((p / w) / 2)) as usize]; 3])
             .collect();
         let zero: Vec<(u32, [f32; 3])> = (0..w * h).map(|p| (p, [0.0; 3])).collect();
-        let a = correlation_area(&white, w, &zero);
-        let b = correlation_area(&blocks, w, &zero);
+        let area = |photo: &[[f32; 3]]| correlation_area(photo, w, &zero, MAX_LAG, PixelShare::All);
+        let (a, b) = (area(&white), area(&blocks));
         assert!(a < 1.6, "{a}");
         assert!((b - 4.0).abs() < 0.8, "{b}");
     }
