@@ -126,10 +126,10 @@ pub struct Args {
     #[arg(long, value_name = "N", value_parser = super::values::count)]
     pub joint_samples: Option<u32>,
     /// Fit every water pixel near the streaks instead of every second one (a checkerboard;
-    /// every fourth, one of each 2 x 2 block, on a photo of more than a megapixel): about twice
-    /// (four times) the joint fit's time, and less of both the samples' and the photo's noise
-    /// (more samples per pixel cannot average the photo's noise). Lights sharing a streak get
-    /// this by default (see --joint-samples).
+    /// one of each 2 x 2 block on a photo of more than a megapixel, of each 4 x 4 block at
+    /// 4000 x 3000): about twice the joint fit's time (four times or more), and less of both
+    /// the samples' and the photo's noise (more samples per pixel cannot average the photo's
+    /// noise). Lights sharing a streak get this by default (see --joint-samples).
     #[arg(long)]
     pub all_pixels: bool,
     /// Fit the water pixels alone: without this, the joint fit also reads the pixels that
