@@ -164,14 +164,14 @@ pub enum PixelShare {
     WaterBlocks(u32),
     /// Every fourth pixel, one of each 2 x 2 block (even column, even row), of the water and of
     /// the direct view: enough for a search that compares the costs of fits over the same
-    /// pixels, where where the minimum lies matters and not how well each fit pins its lights.
+    /// pixels, where the minimum lies matters and not how well each fit pins its lights.
     Quarter,
 }
 
 /// The most pixels of a photo whose joint fit reads a checkerboard of its water pixels by
 /// default; a larger photo's fit reads one of each block of them
-/// ([`PixelShare::WaterBlocks`]), so that the water pixels read grow no faster than
-/// [`LARGE_PHOTO_PIXELS`] over 4. A 1920 x 1080 photo has 2.07 million.
+/// ([`PixelShare::WaterBlocks`]), a block large enough that the pixels it could read stay
+/// under this many. A 1920 x 1080 photo has 2.07 million.
 pub const LARGE_PHOTO_PIXELS: u64 = 1_000_000;
 
 impl PixelShare {

@@ -233,6 +233,33 @@ mod tests {
         let (a, b) = (area(&white), area(&blocks));
         assert!(a < 1.6, "{a}");
         assert!((b - 4.0).abs() < 0.8, "{b}");
+        // Read one pixel of each 2 x 2 block, the block noise is white again: each pixel read
+        // is an independent value, so the area in pixels read is 1, not 4. Read on a
+        // checkerboard, a block's two pixels read are diagonal neighbours along (1, 1): the
+        // lags (1, 1) and (-1, -1) each pair half the pixels read with their block's other,
+        // the lags (1, -1) and (-1, 1) none, so 1 + 2 x 1/2 = 2.
+        let read = |share: PixelShare| -> Vec<(u32, [f32; 3])> {
+            zero.iter()
+                .copied()
+                .filter(|&(p, _)| share.reads(p % w, p / w))
+                .collect()
+        };
+        let quarter = correlation_area(
+            &blocks,
+            w,
+            &read(PixelShare::WaterBlocks(2)),
+            MAX_LAG,
+            PixelShare::WaterBlocks(2),
+        );
+        let half = correlation_area(
+            &blocks,
+            w,
+            &read(PixelShare::Checkerboard),
+            MAX_LAG,
+            PixelShare::Checkerboard,
+        );
+        assert!(quarter < 1.6, "{quarter}");
+        assert!((half - 2.0).abs() < 0.5, "{half}");
     }
 
     #[test]
