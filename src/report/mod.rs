@@ -91,9 +91,10 @@ pub struct Settings {
     /// method).
     pub joint_samples: Option<u32>,
     /// Which pixels of its region the (final) joint fit read: "checkerboard" (every second
-    /// one, the default up to a megapixel), "one water pixel of each B x B block" (and a
-    /// checkerboard of those that see a light: the default on a larger photo,
-    /// [`crate::fitting::joint::PixelShare::water_blocks`]), "all" ([`crate::pipeline::Reading::all_pixels`]) or "quarter"
+    /// one, the default up to a megapixel), "one water pixel of each B x B block" (and those
+    /// that see a light on every B-th diagonal: the default on a larger photo,
+    /// [`crate::fitting::joint::PixelShare::water_blocks`]), "all"
+    /// ([`crate::pipeline::Reading::all_pixels`]) or "quarter"
     /// ([`crate::fitting::joint::PixelShare`]); `None` for the paper method.
     pub joint_pixels: Option<String>,
     /// Divisor applied to the photo's linear values: linear value per unit of radiance.

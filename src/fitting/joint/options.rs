@@ -154,12 +154,13 @@ pub enum PixelShare {
     /// Every second pixel, on a checkerboard: the fit's default on a photo of up to
     /// [`LARGE_PHOTO_PIXELS`].
     Checkerboard,
-    /// One water pixel of each `b` x `b` block (column and row multiples of `b`) and a
-    /// checkerboard of the pixels that see a light directly: the fit's default on a photo of
-    /// more than [`LARGE_PHOTO_PIXELS`], `b` growing with its size
-    /// ([`PixelShare::water_blocks`]). There a glint covers several pixels, so neighbouring
-    /// water pixels tell little more than one of them, while a direct image's edge is pinned
-    /// by every row or column it crosses, which a checkerboard reads and a block grid does
+    /// One water pixel of each `b` x `b` block (column and row multiples of `b`) and, of the
+    /// pixels that see a light directly, those on every `b`-th diagonal (`x + y` a multiple
+    /// of `b`; a checkerboard for `b` = 2): the fit's default on a photo of more than
+    /// [`LARGE_PHOTO_PIXELS`], `b` growing with its size ([`PixelShare::water_blocks`]).
+    /// There a glint covers several pixels, so neighbouring water pixels tell little more
+    /// than one of them, while a direct image's edge is pinned by every row or column it
+    /// crosses, which the diagonals read, one pixel in `b` of each, and a block grid does
     /// not.
     WaterBlocks(u32),
     /// Every fourth pixel, one of each 2 x 2 block (even column, even row), of the water and of
@@ -220,7 +221,7 @@ impl PixelShare {
     /// Whether the pixel in column `x`, row `y` is read where it sees a light's wall directly.
     pub fn reads_direct(self, x: u32, y: u32) -> bool {
         match self {
-            PixelShare::WaterBlocks(_) => PixelShare::Checkerboard.reads(x, y),
+            PixelShare::WaterBlocks(b) => (x + y).is_multiple_of(b.max(1)),
             share => share.reads(x, y),
         }
     }
@@ -313,6 +314,16 @@ mod tests {
         let blocks = read(PixelShare::WaterBlocks(4));
         assert_eq!(blocks.len(), 625);
         assert!(blocks.iter().all(|&(x, y)| x % 4 == 0 && y % 4 == 0));
+        // Its direct view reads a quarter of the pixels, 25 of each row and of each column.
+        let direct: Vec<(u32, u32)> = (0..100u32)
+            .flat_map(|y| (0..100u32).map(move |x| (x, y)))
+            .filter(|&(x, y)| PixelShare::WaterBlocks(4).reads_direct(x, y))
+            .collect();
+        assert_eq!(direct.len(), 2500);
+        for line in 0..100u32 {
+            assert_eq!(direct.iter().filter(|p| p.1 == line).count(), 25);
+            assert_eq!(direct.iter().filter(|p| p.0 == line).count(), 25);
+        }
     }
 
     /// The block's side is the least `b` with `b^2` megapixels holding the photo.
