@@ -420,9 +420,9 @@ impl Run<'_> {
             return Ok(());
         }
         self.progress.stage(&format!(
-            "lights share a streak: joint fit again over {} pixels with {} samples",
-            reading.share(self.photo.len() as u64).name(),
-            reading.samples
+            "lights share a streak: joint fit again with {} samples (pixels read: {})",
+            reading.samples,
+            reading.share(self.photo.len() as u64).name()
         ));
         let known = std::mem::take(&mut found.splits);
         let refit = JointOptions {
