@@ -68,6 +68,7 @@ pub mod photo_exif;
 pub mod photo_in;
 pub mod photo_out;
 pub mod pipeline;
+pub mod pixel_index;
 pub mod pixel_scale;
 pub mod plane;
 pub mod progress;

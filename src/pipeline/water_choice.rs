@@ -22,6 +22,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::photo_in::Photo;
+use crate::pixel_index::PixelIndex;
 use crate::pixel_scale::scaled_pixels;
 
 /// Half the side of the window whose mean is subtracted, in pixels, on the samples' photos:
@@ -186,19 +187,7 @@ pub fn fine_structure(
         return None;
     }
     let w = width as i64;
-    // Where each pixel of the fitted pixels' bounding box is among them: a dense grid, not a
-    // map (the window reads 49 neighbours of each of up to a few hundred thousand pixels).
-    let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
-    for &(p, _) in modelled {
-        let (x, y) = (p as i64 % w, p as i64 / w);
-        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
-    }
-    let box_width = x1 - x0 + 1;
-    let mut index = vec![usize::MAX; (box_width * (y1 - y0 + 1)) as usize];
-    for (i, &(p, _)) in modelled.iter().enumerate() {
-        let (x, y) = (p as i64 % w, p as i64 / w);
-        index[((y - y0) * box_width + x - x0) as usize] = i;
-    }
+    let index = PixelIndex::new(modelled.iter().map(|m| m.0), width);
     let sum = |c: [f32; 3]| (c[0] + c[1] + c[2]) as f64;
     let photo_value: Vec<f64> = modelled
         .iter()
@@ -222,12 +211,7 @@ pub fn fine_structure(
             let (mut mp, mut mm, mut n) = (0.0, 0.0, 0.0);
             for dy in -r..=r {
                 for dx in -r..=r {
-                    let (nx, ny) = (x + dx, y + dy);
-                    if nx < x0 || nx > x1 || ny < y0 || ny > y1 {
-                        continue;
-                    }
-                    let j = index[((ny - y0) * box_width + nx - x0) as usize];
-                    if j != usize::MAX {
+                    if let Some(j) = index.at(x + dx, y + dy) {
                         mp += photo_value[j];
                         mm += model_value[j];
                         n += 1.0;

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use crate::fitting::joint::{PixelShare, Uncertainty};
 use crate::fitting::EdgeSide;
 use crate::fitting::FittedLight;
+use crate::pixel_index::PixelIndex;
 
 /// The largest lag, in pixels along each axis, of the residual's correlation area on the
 /// samples' photos; on a finer photo it grows with the rows per degree
@@ -37,7 +38,7 @@ pub fn correlation_area(
     share: PixelShare,
 ) -> f64 {
     let w = width as i64;
-    // In the order given, so that every sum is taken in one order (determinism); the grid
+    // In the order given, so that every sum is taken in one order (determinism); the index
     // only finds a pixel's neighbours.
     let residual: Vec<(i64, f64)> = modelled
         .iter()
@@ -56,17 +57,7 @@ pub fn correlation_area(
     if var <= 0.0 {
         return 1.0;
     }
-    // The residual on the fitted pixels' bounding box, NaN where no pixel was fitted.
-    let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
-    for &(p, _) in &residual {
-        let (x, y) = (p % w, p / w);
-        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
-    }
-    let box_width = x1 - x0 + 1;
-    let mut grid = vec![f64::NAN; (box_width * (y1 - y0 + 1)) as usize];
-    for &(p, r) in &residual {
-        grid[((p / w - y0) * box_width + p % w - x0) as usize] = r;
-    }
+    let index = PixelIndex::new(modelled.iter().map(|m| m.0), width);
     let lags: Vec<(i64, i64)> = (-max_lag..=max_lag)
         .flat_map(|dy| (-max_lag..=max_lag).map(move |dx| (dx, dy)))
         .filter(|&(dx, dy)| share.lag_between_read(dx, dy))
@@ -76,12 +67,8 @@ pub fn correlation_area(
         .map(|&(dx, dy)| {
             let (mut sum, mut n) = (0.0, 0usize);
             for &(p, r) in &residual {
-                let (qx, qy) = (p % w + dx, p / w + dy);
-                if qx < x0 || qx > x1 || qy < y0 || qy > y1 {
-                    continue;
-                }
-                let s = grid[((qy - y0) * box_width + qx - x0) as usize];
-                if !s.is_nan() {
+                if let Some(j) = index.at(p % w + dx, p / w + dy) {
+                    let s = residual[j].1;
                     sum += (r - mean) * (s - mean);
                     n += 1;
                 }
