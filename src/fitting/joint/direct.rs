@@ -38,6 +38,7 @@ use super::samples::CAMERA_STRATA;
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::fitting::EdgeSide;
+use crate::photo_in::rounding_sigma;
 use crate::scene_in::Scene;
 
 /// What a probe ray through a pixel corner sees first.
@@ -261,15 +262,20 @@ fn stratum_cell(
     }
 }
 
+/// Fewest pixels that see a light whole for its image's rounding to count
+/// ([`Problem::shared_rounding`]).
+const MIN_WHOLE_PIXELS: usize = 16;
+
 impl Problem {
-    /// Whether fitted pixel i measures the model for the uncertainties: not clipped (a lower
-    /// bound), and, for a direct pixel, not at the photo's black level either. A black pixel
+    /// Whether channel `ch` of fitted pixel i measures the model for the uncertainties: not
+    /// clipped (a lower bound), and, for a direct pixel, not at the photo's black level in
+    /// every channel either. A black pixel
     /// next to a light's image says that the light covers none of it, a bound on one side of
     /// an edge as a clipped one is on the other; between such bounds the edge is free, and
     /// a curvature taken across them would claim it pinned (Table 1's left edge, between a
     /// black and a clipped column of pixels, came out at 0.04 mm against a 0.8 mm error).
-    pub(super) fn measures(&self, i: usize) -> bool {
-        !self.clipped[i] && (i < self.first_direct || self.obs[i] != [0.0; 3])
+    pub(super) fn measures(&self, i: usize, ch: usize) -> bool {
+        !self.clipped_channels[i][ch] && (i < self.first_direct || self.obs[i] != [0.0; 3])
     }
 
     /// The step over which the direct pixels' coefficients of set `set` are differentiated
@@ -316,6 +322,39 @@ impl Problem {
             !points.is_empty()
                 && points.iter().all(|p| rect.contains(*p))
                 && (0..3).any(|c| radiance[c] > 0.0 && !self.clipped_channels[i][c])
+        })
+    }
+
+    /// Per channel, the variance (radiance units squared) the photo's rounding leaves in a
+    /// radiance read off the image of a light of set `set` and rectangle `rect`: the pixels
+    /// that see it whole hold one value, rounded alike, so their number does not average the
+    /// rounding away ([`rounding_sigma`] at their median value). 0 for a channel fewer than
+    /// [`MIN_WHOLE_PIXELS`] such pixels measure ([`Problem::measures`]), and for a photo of
+    /// floating-point values.
+    pub(super) fn shared_rounding(&self, set: usize, rect: &Rect) -> [f64; 3] {
+        let (step, exposure) = self.encoding;
+        if step <= 0.0 || self.first_direct >= self.n() {
+            return [0.0; 3];
+        }
+        let samples = &self.planes[set];
+        let whole: Vec<usize> = (self.first_direct..self.n())
+            .filter(|&i| {
+                let points = &samples.points[samples.range(i)];
+                !points.is_empty() && points.iter().all(|p| rect.contains(*p))
+            })
+            .collect();
+        std::array::from_fn(|ch| {
+            let mut values: Vec<f32> = whole
+                .iter()
+                .filter(|&&i| self.measures(i, ch))
+                .map(|&i| self.obs[i][ch])
+                .collect();
+            if values.len() < MIN_WHOLE_PIXELS {
+                return 0.0;
+            }
+            let mid = values.len() / 2;
+            let median = *values.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
+            (rounding_sigma(median * exposure, step) as f64 / exposure as f64).powi(2)
         })
     }
 

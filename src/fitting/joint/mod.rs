@@ -141,7 +141,7 @@ pub use outcome::JointOutcome;
 pub use proposal::{Lobe, ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
 pub use samples::effective_samples;
 pub use split::{Split, SplitWay};
-pub use uncertainty::{edge_statuses, Uncertainty};
+pub use uncertainty::{edge_statuses, Uncertainty, VarianceParts};
 
 use direct::direct_pixels;
 use direct_start::enclosing_image;
@@ -293,6 +293,7 @@ pub fn fit_joint_with(
             set_origin: (0..planes.len()).collect(),
             inv_samples: 1.0 / per_pixel_samples as f32,
             first_direct,
+            encoding: (photo.encoding_step, photo.exposure),
         }
     };
     // Rows weighted from the start by a fit before over the same pixels (`row_scales`).
@@ -571,12 +572,19 @@ fn finish(
     extents: &[Option<Rect>],
     spread: Option<&[([f32; 4], [f32; 3])]>,
 ) -> Vec<Uncertainty> {
-    colour::colour_from_own_pixels(problem, st);
-    let mut uncertainty = uncertainties(problem, st, extents);
+    let colours = colour::colour_from_own_pixels(problem, st);
+    let mut uncertainty = uncertainties(problem, st, extents, &colours);
     for (u, (edges, radiance)) in uncertainty.iter_mut().zip(spread.into_iter().flatten()) {
-        u.edges = EdgeSide::ALL.map(|e| u.edges[e].map(|sd| sd.hypot(edges[e as usize])));
-        u.radiance = [0, 1, 2].map(|c| u.radiance[c].hypot(radiance[c]));
-        u.bound_by_image();
+        let spread = [
+            edges[0],
+            edges[1],
+            edges[2],
+            edges[3],
+            radiance[0],
+            radiance[1],
+            radiance[2],
+        ];
+        u.add_other(spread.map(|sd| (sd as f64).powi(2)));
     }
     uncertainty
 }

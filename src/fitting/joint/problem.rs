@@ -30,6 +30,9 @@ pub(super) struct Problem {
     /// The fitted pixels from this index on see the lights' walls directly (outside the
     /// water: [`super::direct`]); those before it are water pixels.
     pub(super) first_direct: usize,
+    /// The photo's encoding step and exposure ([`Photo::encoding_step`](crate::photo_in::Photo::encoding_step)):
+    /// the rounding a lamp's image seen whole shares ([`crate::photo_in::rounding_sigma`]).
+    pub(super) encoding: (f32, f32),
 }
 
 /// The state of a fit: every light's rectangle and radiance, and the coefficients they give.

@@ -204,6 +204,7 @@ mod tests {
             set_origin: vec![0],
             inv_samples: 1.0,
             first_direct: n,
+            encoding: (0.0, 1.0),
         };
         let st = State {
             set_of: vec![0; lights],
@@ -223,6 +224,7 @@ mod tests {
             direct_pixels: 0,
             radiance_seen: false,
             image_bound: [None; 4],
+            parts: [None; 7],
         }
     }
 

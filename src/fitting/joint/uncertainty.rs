@@ -2,6 +2,7 @@
 //! uncertainties of every light's edges and radiances from the curvature of the cost the fit
 //! minimises, and which edges the photo does not determine.
 
+use super::colour::ColourRule;
 use super::problem::{Problem, State};
 use crate::fitting::linalg::invert;
 use crate::fitting::rect::Rect;
@@ -29,9 +30,54 @@ pub struct Uncertainty {
     /// would make the pixels that see the light disagree with the photo); `None` where the
     /// image does not pin it. The edge's sigma never exceeds it ([`Uncertainty::bound_by_image`]).
     pub image_bound: [Option<f32>; 4],
+    /// Per parameter (the left, right, bottom and top edges, then the three radiances), its
+    /// variance in two parts ([`VarianceParts`]); `None` for an edge the photo does not
+    /// constrain, or where the covariance could not be had.
+    pub parts: [Option<VarianceParts>; 7],
+}
+
+/// A parameter's variance in two parts: what the water's pixels give, which the glitter's
+/// correlation grows under the statistical model ([`Uncertainty::widen`]), and the rest,
+/// which it does not: the pixels that see the light directly, the colour ratio of a channel
+/// set from another ([`super::colour`]), the repeats' spread.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VarianceParts {
+    /// From the water's pixels, squared units.
+    pub water: f64,
+    /// The rest, squared units.
+    pub other: f64,
 }
 
 impl Uncertainty {
+    /// Each parameter that has [`parts`](Self::parts) gets the sigma `sqrt(area * water +
+    /// other + carried(i))`, `i` indexing the parameters as `parts` does: the water's share
+    /// grown by the residual's correlation area `area` (one value per `area` pixels) and
+    /// `carried(i)` added, a variance carried from outside the fit. Then bound by the image
+    /// ([`Self::bound_by_image`]).
+    pub fn widen(&mut self, area: f64, carried: impl Fn(usize) -> f64) {
+        for (i, parts) in self.parts.iter().enumerate() {
+            let Some(p) = parts else { continue };
+            let sd = (area * p.water + p.other + carried(i)).max(0.0).sqrt() as f32;
+            if i < 4 {
+                self.edges[i] = Some(sd);
+            } else {
+                self.radiance[i - 4] = sd;
+            }
+        }
+        self.bound_by_image();
+    }
+
+    /// Adds `variance` (squared units; per parameter as in [`parts`](Self::parts)) to the
+    /// part the glitter does not grow, and sets the sigmas from the parts.
+    pub(super) fn add_other(&mut self, variance: [f64; 7]) {
+        for (p, v) in self.parts.iter_mut().zip(variance) {
+            if let Some(p) = p {
+                p.other += v;
+            }
+        }
+        self.widen(1.0, |_| 0.0);
+    }
+
     /// Each edge's sigma no larger than its [`image_bound`](Self::image_bound), and one given
     /// where only the image constrains it. Whatever widens the sigmas (the repeats' spread,
     /// the glitter's correlation) says how well the reflections place the edge; the image
@@ -54,16 +100,24 @@ impl Uncertainty {
 ///
 /// An edge's derivative is the change of the coefficients over a step of 2 % of the light's
 /// size (at least 5e-4 of its distance from the camera, 5 mm at 10 m) each way: below a few
-/// millimetres at that distance the stored samples make the coefficients a staircase. A direct pixel's (`direct`) is taken over a quarter of its
-/// footprint, and only the pixels that measure the model count ([`Problem::measures`]: not
-/// clipped, and not black where the light is seen directly). An edge that moves nothing gets no uncertainty (`None`: the photo
-/// does not constrain it), and so does a pinned one. An edge the light's direct image pins
-/// within its pixels (`image_bound`: clipped on one side, black on the other) gets no more
-/// than that bound.
+/// millimetres at that distance the stored samples make the coefficients a staircase. A
+/// direct pixel's (`direct`) is taken over a quarter of its footprint, and only the channels
+/// that measure the model count ([`Problem::measures`]: not clipped, and not black where the
+/// light is seen directly): a lamp's image clipped in its strong channels still measures its
+/// weak one. An edge that moves nothing gets no uncertainty (`None`: the photo does not
+/// constrain it), and so does a pinned one. An edge the light's direct image pins within its
+/// pixels (`image_bound`: clipped on one side, black on the other) gets no more than that
+/// bound.
+///
+/// The variance comes in two parts ([`VarianceParts`]), the water pixels' scores and the
+/// direct pixels' summed apart; a radiance its image gives also carries the rounding its
+/// pixels share ([`Problem::shared_rounding`]). A channel the colour rule set from another (`colours`) gets
+/// that channel's variance times the squared ratio, plus the ratio's own.
 pub(super) fn uncertainties(
     problem: &Problem,
     st: &State,
     extents: &[Option<Rect>],
+    colours: &[Option<ColourRule>],
 ) -> Vec<Uncertainty> {
     let lights = st.rects.len();
     // Parameters: per light its free edges (with the coefficients' derivative and the
@@ -100,7 +154,7 @@ pub(super) fn uncertainties(
                 // sample. Such an edge is left to the other pixels.
                 let measuring = direct
                     .clone()
-                    .filter(|&i| gd[i] != 0.0 && problem.measures(i))
+                    .filter(|&i| gd[i] != 0.0 && (0..3).any(|ch| problem.measures(i, ch)))
                     .count();
                 let keep = measuring >= MIN_DIRECT_PIXELS;
                 for i in direct {
@@ -143,15 +197,19 @@ pub(super) fn uncertainties(
     // all three.
     let mut jtj = vec![0.0; p * p];
     let mut raw_diagonal = vec![0.0; p];
-    let mut meat = vec![0.0; p * p];
+    // The scores' products, the water pixels' and the direct pixels' apart.
+    let mut meats = [vec![0.0; p * p], vec![0.0; p * p]];
     let mut row = vec![0.0; p];
     let mut dev_row = vec![0.0; p];
     let mut score = vec![0.0; p];
-    for i in (0..problem.n()).filter(|&i| problem.measures(i)) {
+    for i in 0..problem.n() {
         let m = problem.model(st, i);
         score.iter_mut().for_each(|x| *x = 0.0);
         let mut any = false;
         for (ch, (obs, model)) in problem.obs[i].iter().zip(m).enumerate() {
+            if !problem.measures(i, ch) {
+                continue;
+            }
             let r = *obs as f64 - model;
             let d: f64 = (0..lights)
                 .map(|k| st.radiance[k][ch] * st.dev[k][i] as f64)
@@ -171,6 +229,7 @@ pub(super) fn uncertainties(
             }
         }
         if any {
+            let meat = &mut meats[usize::from(i >= problem.first_direct)];
             for a in 0..p {
                 if score[a] != 0.0 {
                     for b in 0..p {
@@ -189,22 +248,24 @@ pub(super) fn uncertainties(
     for a in 0..p {
         jtj[a * p + a] += 1e-12 * (1.0 + jtj[a * p + a]);
     }
-    let covariance = invert(&jtj, p).map(|inv| {
-        let product = |x: &[f64], y: &[f64]| {
-            let mut out = vec![0.0; p * p];
-            for a in 0..p {
-                for c in 0..p {
-                    let xa = x[a * p + c];
-                    if xa != 0.0 {
-                        for b in 0..p {
-                            out[a * p + b] += xa * y[c * p + b];
+    // The diagonal of the sandwich inv M inv, for each part's M.
+    let parts = invert(&jtj, p).map(|inv| {
+        meats.map(|meat| {
+            (0..p)
+                .map(|a| {
+                    let mut sum = 0.0;
+                    for b in 0..p {
+                        let ab = inv[a * p + b];
+                        if ab != 0.0 {
+                            for c in 0..p {
+                                sum += ab * meat[b * p + c] * inv[c * p + a];
+                            }
                         }
                     }
-                }
-            }
-            out
-        };
-        product(&product(&inv, &meat), &inv)
+                    sum
+                })
+                .collect::<Vec<f64>>()
+        })
     });
     let mut out: Vec<Uncertainty> = (0..lights)
         .map(|_| Uncertainty {
@@ -213,25 +274,58 @@ pub(super) fn uncertainties(
             direct_pixels: 0,
             radiance_seen: false,
             image_bound: [None; 4],
+            parts: [None; 7],
         })
         .collect();
-    if let Some(cov) = covariance {
+    if let Some([water, direct]) = parts {
         for (a, param) in params.iter().enumerate() {
-            let var = cov[a * p + a];
-            let sd = if var.is_finite() && var >= 0.0 {
-                var.sqrt() as f32
-            } else {
-                f32::INFINITY
+            let (k, i) = match param {
+                Param::Edge(k, side, ..) => (*k, *side as usize),
+                Param::Radiance(k, ch) => (*k, 4 + ch),
             };
-            match param {
-                Param::Edge(k, side, ..) => out[*k].edges[*side] = Some(sd),
-                Param::Radiance(k, ch) => out[*k].radiance[*ch] = sd,
+            let finite = |v: f64| {
+                if v.is_finite() && v >= 0.0 {
+                    v
+                } else {
+                    f64::INFINITY
+                }
+            };
+            out[k].parts[i] = Some(VarianceParts {
+                water: finite(water[a]),
+                other: finite(direct[a]),
+            });
+        }
+    }
+    for (k, u) in out.iter_mut().enumerate() {
+        let rounding = problem.shared_rounding(st.set_of[k], &st.rects[k]);
+        for (p, r) in u.parts[4..].iter_mut().zip(rounding) {
+            if let Some(p) = p {
+                p.other += r;
             }
+        }
+        let Some(rule) = colours.get(k).copied().flatten() else {
+            continue;
+        };
+        let Some(best) = u.parts[4 + rule.best] else {
+            continue;
+        };
+        let from = st.radiance[k][rule.best];
+        for ch in (0..3).filter(|&ch| rule.set[ch]) {
+            let value = st.radiance[k][ch];
+            let f2 = if from > 0.0 {
+                (value / from).powi(2)
+            } else {
+                0.0
+            };
+            u.parts[4 + ch] = Some(VarianceParts {
+                water: f2 * best.water,
+                other: f2 * best.other + value * value * rule.ratio_variance[ch],
+            });
         }
     }
     for (u, bound) in out.iter_mut().zip(problem.image_bounds(st)) {
         u.image_bound = bound;
-        u.bound_by_image();
+        u.widen(1.0, |_| 0.0);
     }
     out
 }

@@ -17,7 +17,6 @@
 use rayon::prelude::*;
 
 use crate::fitting::joint::{PixelShare, Uncertainty};
-use crate::fitting::EdgeSide;
 use crate::fitting::FittedLight;
 use crate::pixel_index::PixelIndex;
 
@@ -166,18 +165,19 @@ pub fn parameter_slopes(points: &[(f64, Vec<FittedLight>)]) -> Option<Vec<[f64; 
     )
 }
 
-/// `uncertainty` of each light grown by `sqrt(area)` (the residual's correlation area), with
-/// the slope variances' uncertainties `sigma_ln` (already so grown) carried through the
-/// parameters' `slopes` by `ln` variance, per axis. Unconstrained edges stay unconstrained,
-/// and an edge the light's direct image bounds stays within that bound
-/// ([`Uncertainty::bound_by_image`]).
+/// `uncertainty` of each light with the water's share of every variance grown by `area` (the
+/// residual's correlation area: the glitter's pixels are not independent, the pixels that see
+/// a light directly are, and so is a colour ratio;
+/// [`VarianceParts`](crate::fitting::joint::VarianceParts)), and the slope variances'
+/// uncertainties `sigma_ln` (already so grown) carried through the parameters' `slopes` by
+/// `ln` variance, per axis. Unconstrained edges stay unconstrained, and an edge the light's
+/// direct image bounds stays within that bound ([`Uncertainty::bound_by_image`]).
 pub fn widen(
     uncertainty: &mut [Uncertainty],
     area: f64,
     slopes: [Option<&Vec<[f64; 7]>>; 2],
     sigma_ln: [Option<f32>; 2],
 ) {
-    let grow = area.max(1.0).sqrt();
     for (k, u) in uncertainty.iter_mut().enumerate() {
         let carried = |i: usize| -> f64 {
             (0..2)
@@ -187,21 +187,15 @@ pub fn widen(
                 })
                 .sum()
         };
-        for side in EdgeSide::ALL {
-            let i = side as usize;
-            u.edges[side] =
-                u.edges[side].map(|sd| ((sd as f64 * grow).powi(2) + carried(i)).sqrt() as f32);
-        }
-        for c in 0..3 {
-            u.radiance[c] = ((u.radiance[c] as f64 * grow).powi(2) + carried(4 + c)).sqrt() as f32;
-        }
-        u.bound_by_image();
+        u.widen(area.max(1.0), carried);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fitting::joint::VarianceParts;
+    use crate::fitting::EdgeSide;
 
     /// White noise has a correlation area of 1; noise constant over 2 x 2 blocks, of 4 (the
     /// pixels per independent value: 1 + 4 x 1/2 + 4 x 1/4). The estimate sums 289 lags'
@@ -274,21 +268,43 @@ mod tests {
             (s[0][0] - 0.5).abs() < 1e-5 && (s[0][4] + 2.0).abs() < 1e-4,
             "{s:?}"
         );
+        let water = |sd: f64| {
+            Some(VarianceParts {
+                water: sd * sd,
+                other: 0.0,
+            })
+        };
+        // Red: half its variance from the water, half from the lamp's image.
+        let red = VarianceParts {
+            water: 0.005,
+            other: 0.005,
+        };
         let mut u = vec![Uncertainty {
             edges: [Some(0.03), None, Some(0.01), Some(0.01)],
             radiance: [0.1; 3],
             direct_pixels: 0,
             radiance_seen: false,
             image_bound: [None, None, Some(0.015), None],
+            parts: [
+                water(0.03),
+                None,
+                water(0.01),
+                water(0.01),
+                Some(red),
+                water(0.1),
+                water(0.1),
+            ],
         }];
         widen(&mut u, 4.0, [Some(&s), None], [Some(0.1), None]);
-        // Left: (0.03 * 2)^2 + (0.5 * 0.1)^2; radiance: (0.1 * 2)^2 + (2 * 0.1)^2.
+        // Left: (0.03 * 2)^2 + (0.5 * 0.1)^2; green: (0.1 * 2)^2 + (2 * 0.1)^2.
         assert!((u[0].edges[EdgeSide::Left].unwrap() - 0.0781).abs() < 1e-3);
         assert_eq!(u[0].edges[EdgeSide::Right], None);
         // Bottom: 0.01 * 2, more than its image allows; top: 0.01 * 2.
         assert_eq!(u[0].edges[EdgeSide::Bottom], Some(0.015));
         assert!((u[0].edges[EdgeSide::Top].unwrap() - 0.02).abs() < 1e-6);
-        assert!((u[0].radiance[0] - 0.2828).abs() < 1e-3);
+        assert!((u[0].radiance[1] - 0.2828).abs() < 1e-3);
+        // Red: 4 x 0.005 + 0.005 + (2 * 0.1)^2 = 0.065; grown whole it would be 0.08.
+        assert!((u[0].radiance[0] - 0.065f32.sqrt()).abs() < 1e-5);
     }
 
     #[test]
@@ -300,6 +316,7 @@ mod tests {
             direct_pixels: 0,
             radiance_seen: seen,
             image_bound: [None; 4],
+            parts: [None; 7],
         };
         let mut u = vec![sigma(false), sigma(true)];
         realisation_floor(&mut u, &lights);
