@@ -225,6 +225,7 @@ mod tests {
             radiance_seen: false,
             image_bound: [None; 4],
             parts: [None; 7],
+            radiance_response: [0.0; 4],
         }
     }
 

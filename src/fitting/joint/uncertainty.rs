@@ -34,6 +34,13 @@ pub struct Uncertainty {
     /// variance in two parts ([`VarianceParts`]); `None` for an edge the photo does not
     /// constrain, or where the covariance could not be had.
     pub parts: [Option<VarianceParts>; 7],
+    /// Per edge, metres per unit `e`: how far the edge moves when the light's radiance is
+    /// scaled by `1 + e` and the other parameters fitted again (the curvature's conditional
+    /// response). An error of the radiance's scale that no residual shows (one realisation of
+    /// the waves) carries into the edges by it (`slopes::realisation_floor`): a lamp's image
+    /// clipped inside pins an edge by the pixels it crosses, whose values are radiance times
+    /// coverage. 0 for an edge that is not fitted.
+    pub radiance_response: [f64; 4],
 }
 
 /// A parameter's variance in two parts: what the water's pixels give, which the glitter's
@@ -275,8 +282,45 @@ pub(super) fn uncertainties(
             radiance_seen: false,
             image_bound: [None; 4],
             parts: [None; 7],
+            radiance_response: [0.0; 4],
         })
         .collect();
+    // Each light's edges' response to a scale of its radiance: the edges' block of the
+    // curvature solved against its coupling to the radiance so scaled.
+    let edge_params: Vec<usize> = (0..p)
+        .filter(|&a| matches!(params[a], Param::Edge(..)))
+        .collect();
+    let ne = edge_params.len();
+    let block: Vec<f64> = edge_params
+        .iter()
+        .flat_map(|&a| edge_params.iter().map(move |&b| (a, b)))
+        .map(|(a, b)| jtj[a * p + b])
+        .collect();
+    if let Some(block_inv) = invert(&block, ne).filter(|_| ne > 0) {
+        for (k, u) in out.iter_mut().enumerate() {
+            let coupling: Vec<f64> = edge_params
+                .iter()
+                .map(|&a| {
+                    (0..p)
+                        .filter_map(|b| match params[b] {
+                            Param::Radiance(kk, ch) if kk == k => {
+                                Some(jtj[a * p + b] * st.radiance[k][ch])
+                            }
+                            _ => None,
+                        })
+                        .sum()
+                })
+                .collect();
+            for (x, &a) in edge_params.iter().enumerate() {
+                if let Param::Edge(kk, side, ..) = params[a] {
+                    if kk == k {
+                        let moved: f64 = (0..ne).map(|y| block_inv[x * ne + y] * coupling[y]).sum();
+                        u.radiance_response[side as usize] = -moved;
+                    }
+                }
+            }
+        }
+    }
     if let Some([water, direct]) = parts {
         for (a, param) in params.iter().enumerate() {
             let (k, i) = match param {

@@ -17,7 +17,7 @@
 use rayon::prelude::*;
 
 use crate::fitting::joint::{PixelShare, Uncertainty};
-use crate::fitting::FittedLight;
+use crate::fitting::{EdgeSide, FittedLight};
 use crate::pixel_index::PixelIndex;
 
 /// The largest lag, in pixels along each axis, of the residual's correlation area on the
@@ -101,10 +101,30 @@ pub const REALISATION_FLUX: f64 = 0.05;
 /// `f32`, so that it never reaches above the report's large uncertainty
 /// ([`crate::report::LARGE_UNCERTAINTY`], the same 5 %) by rounding: a light is warned about
 /// only when the fit's own sigma is larger.
+///
+/// The relative variance the floor adds to the light's strongest channel is a scale error of
+/// its radiance, and it carries into each edge by its
+/// [`radiance_response`](Uncertainty::radiance_response): Table 1 over a flat quad (its
+/// radiance 7.5 % low) put its bottom edge 0.74 mm off, where the fit's own sigma, the lamp's
+/// image alone, was 0.24 mm.
 pub fn realisation_floor(uncertainty: &mut [Uncertainty], radiance: &[[f32; 3]]) {
     for (u, light) in uncertainty.iter_mut().zip(radiance) {
         if u.radiance_seen {
             continue;
+        }
+        let strongest = (0..3)
+            .max_by(|&a, &b| light[a].abs().total_cmp(&light[b].abs()))
+            .unwrap_or(0);
+        let l = light[strongest].abs() as f64;
+        if l > 0.0 {
+            let own = u.radiance[strongest] as f64 / l;
+            let added = (REALISATION_FLUX * REALISATION_FLUX - own * own).max(0.0);
+            for side in EdgeSide::ALL {
+                let response = u.radiance_response[side as usize];
+                u.edges[side] =
+                    u.edges[side].map(|sd| (sd as f64).hypot(response * added.sqrt()) as f32);
+            }
+            u.bound_by_image();
         }
         for (sd, l) in u.radiance.iter_mut().zip(light) {
             let exact = REALISATION_FLUX * l.abs() as f64;
@@ -195,7 +215,6 @@ pub fn widen(
 mod tests {
     use super::*;
     use crate::fitting::joint::VarianceParts;
-    use crate::fitting::EdgeSide;
 
     /// White noise has a correlation area of 1; noise constant over 2 x 2 blocks, of 4 (the
     /// pixels per independent value: 1 + 4 x 1/2 + 4 x 1/4). The estimate sums 289 lags'
@@ -294,6 +313,7 @@ mod tests {
                 water(0.1),
                 water(0.1),
             ],
+            radiance_response: [0.0; 4],
         }];
         widen(&mut u, 4.0, [Some(&s), None], [Some(0.1), None]);
         // Left: (0.03 * 2)^2 + (0.5 * 0.1)^2; green: (0.1 * 2)^2 + (2 * 0.1)^2.
@@ -317,6 +337,7 @@ mod tests {
             radiance_seen: seen,
             image_bound: [None; 4],
             parts: [None; 7],
+            radiance_response: [0.1, 0.0, 0.0, 0.0],
         };
         let mut u = vec![sigma(false), sigma(true)];
         realisation_floor(&mut u, &lights);
@@ -333,7 +354,12 @@ mod tests {
             assert!(sd <= REALISATION_FLUX * l as f64, "{l}: {sd}");
             assert!(sd > 0.999_999 * REALISATION_FLUX * l as f64, "{l}: {sd}");
         }
-        assert_eq!(u[0].edges, [Some(0.01); 4]);
+        // The left edge moves 0.1 m per unit scale: the floor adds 0.05^2 - (0.3 / 20)^2 of
+        // relative variance to the strongest channel, so 0.1^2 times that to the edge.
+        let left = (0.01f64.powi(2) + 0.01 * (0.0025 - 0.015f64.powi(2))).sqrt();
+        assert!((u[0].edges[EdgeSide::Left].unwrap() as f64 - left).abs() < 1e-6);
+        assert_eq!(u[0].edges[1..], [Some(0.01); 3]);
+        assert_eq!(u[1].edges, [Some(0.01); 4]);
         // Seen: left as it was.
         assert_eq!(u[1].radiance, [0.3, 0.8, 0.0]);
     }
