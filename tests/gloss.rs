@@ -361,10 +361,10 @@ fn gloss_auto_through_the_converter() {
             )),
         "{lines:?}"
     );
-    // The final fit's samples, not the joint fit's own default.
+    // The final fit reads what a fit of a given gloss reads; the search's own fits more.
     assert_eq!(
         report.settings.joint_samples,
-        Some(streaklight::fitting::gloss::SEARCH_SAMPLES)
+        Some(streaklight::fitting::joint::DEFAULT_JOINT_SAMPLES)
     );
     assert_eq!(report.lights.len(), 1);
     let light = &report.lights[0];

@@ -3,7 +3,7 @@
 //! the gloss is part of the joint fit's), and each value is held in one place.
 
 use super::water_choice::WaterChoice;
-use crate::fitting::gloss::{GlossSearch, SEARCH_SAMPLES};
+use crate::fitting::gloss::GlossSearch;
 use crate::fitting::joint::{PixelShare, DEFAULT_JOINT_SAMPLES};
 use crate::fitting::DEFAULT_SAMPLES;
 use crate::optics::Shadowing;
@@ -150,13 +150,14 @@ impl Default for JointSettings {
 }
 
 impl JointSettings {
-    /// Estimating the gloss with the default search: the final fit reads [`SEARCH_SAMPLES`]
-    /// samples (the search's own; the cost is not to be trusted with fewer) over a
-    /// checkerboard, without a refit of lights that share a streak.
+    /// Estimating the gloss with the default search (its fits read [`SEARCH_SAMPLES`](crate::fitting::gloss::SEARCH_SAMPLES)
+    /// samples: their costs are not to be trusted with fewer); the final fit at the estimate
+    /// reads [`DEFAULT_JOINT_SAMPLES`] over a checkerboard, as a fit of a given gloss does,
+    /// without a refit of lights that share a streak.
     pub fn estimating_gloss() -> Self {
         JointSettings {
             reading: Reading {
-                samples: SEARCH_SAMPLES,
+                samples: DEFAULT_JOINT_SAMPLES,
                 all_pixels: false,
             },
             overlap_refit: None,
