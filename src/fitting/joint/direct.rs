@@ -269,11 +269,11 @@ const MIN_WHOLE_PIXELS: usize = 16;
 impl Problem {
     /// Whether channel `ch` of fitted pixel i measures the model for the uncertainties: not
     /// clipped (a lower bound), and, for a direct pixel, not at the photo's black level in
-    /// every channel either. A black pixel
-    /// next to a light's image says that the light covers none of it, a bound on one side of
-    /// an edge as a clipped one is on the other; between such bounds the edge is free, and
-    /// a curvature taken across them would claim it pinned (Table 1's left edge, between a
-    /// black and a clipped column of pixels, came out at 0.04 mm against a 0.8 mm error).
+    /// every channel either. A black pixel next to a light's image says that the light covers
+    /// none of it, a bound on one side of an edge as a clipped one is on the other; between
+    /// such bounds the edge is free, and a curvature taken across them would claim it pinned
+    /// (Table 1's left edge, between a black and a clipped column of pixels, came out at
+    /// 0.04 mm against a 0.8 mm error).
     pub(super) fn measures(&self, i: usize, ch: usize) -> bool {
         !self.clipped_channels[i][ch] && (i < self.first_direct || self.obs[i] != [0.0; 3])
     }
@@ -316,12 +316,17 @@ impl Problem {
     /// only the reflections give it (a light out of frame or hidden, or one whose image clips
     /// in every channel).
     pub(super) fn sees_radiance(&self, set: usize, rect: &Rect, radiance: [f64; 3]) -> bool {
+        self.seeing_whole(set, rect)
+            .any(|i| (0..3).any(|c| radiance[c] > 0.0 && !self.clipped_channels[i][c]))
+    }
+
+    /// The direct pixels that see a light of set `set` and rectangle `rect` whole: every one
+    /// of their samples inside the rectangle.
+    fn seeing_whole<'a>(&'a self, set: usize, rect: &'a Rect) -> impl Iterator<Item = usize> + 'a {
         let samples = &self.planes[set];
-        (self.first_direct..self.n()).any(|i| {
+        (self.first_direct..self.n()).filter(move |&i| {
             let points = &samples.points[samples.range(i)];
-            !points.is_empty()
-                && points.iter().all(|p| rect.contains(*p))
-                && (0..3).any(|c| radiance[c] > 0.0 && !self.clipped_channels[i][c])
+            !points.is_empty() && points.iter().all(|p| rect.contains(*p))
         })
     }
 
@@ -336,13 +341,7 @@ impl Problem {
         if step <= 0.0 || self.first_direct >= self.n() {
             return [0.0; 3];
         }
-        let samples = &self.planes[set];
-        let whole: Vec<usize> = (self.first_direct..self.n())
-            .filter(|&i| {
-                let points = &samples.points[samples.range(i)];
-                !points.is_empty() && points.iter().all(|p| rect.contains(*p))
-            })
-            .collect();
+        let whole: Vec<usize> = self.seeing_whole(set, rect).collect();
         std::array::from_fn(|ch| {
             let mut values: Vec<f32> = whole
                 .iter()

@@ -118,8 +118,8 @@ impl Uncertainty {
 ///
 /// The variance comes in two parts ([`VarianceParts`]), the water pixels' scores and the
 /// direct pixels' summed apart; a radiance its image gives also carries the rounding its
-/// pixels share ([`Problem::shared_rounding`]). A channel the colour rule set from another (`colours`) gets
-/// that channel's variance times the squared ratio, plus the ratio's own.
+/// pixels share ([`Problem::shared_rounding`]). A channel the colour rule set from another
+/// (`colours`) gets that channel's variance times the squared ratio, plus the ratio's own.
 pub(super) fn uncertainties(
     problem: &Problem,
     st: &State,
