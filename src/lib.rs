@@ -6,7 +6,7 @@
 //! | step | module |
 //! |---|---|
 //! | 1. load the scene, bake transforms, build the BVH | [`scene_in`], [`tracing`] |
-//! | 2. decode the photo, mark clipped and water pixels | [`photo_in`], [`water_mask`] |
+//! | 2. decode the photo, mark clipped and water pixels | [`photo_in`] ([`photo_rounding`]), [`water_mask`] |
 //! | a night's smooth background, taken off the photo | [`background`] |
 //! | 3-6. superpixels, seeds, streaks, streak edges | [`streaks`] |
 //! | reflection model (§4) | [`optics`] |
@@ -67,6 +67,7 @@ pub mod output_file;
 pub mod photo_exif;
 pub mod photo_in;
 pub mod photo_out;
+pub mod photo_rounding;
 pub mod pipeline;
 pub mod pixel_index;
 pub mod pixel_scale;

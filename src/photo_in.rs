@@ -9,6 +9,7 @@ use std::path::Path;
 
 use image::{DynamicImage, ImageDecoder};
 
+use crate::photo_rounding::Rounding;
 use crate::settings::Setting;
 use crate::{Error, Result};
 
@@ -29,9 +30,8 @@ pub struct Photo {
     pub display: Vec<[f32; 3]>,
     /// True when the file held floating-point (linear, unclipped) values.
     pub is_linear_float: bool,
-    /// The encoding's step in display units: 1/255 for 8 bits, 1/65535 for 16, 0 for
-    /// floating-point values ([`rounding_sigma`]).
-    pub encoding_step: f32,
+    /// How the file rounded its values.
+    pub rounding: Rounding,
     /// The exposure the file's linear values were divided by.
     pub exposure: f32,
     /// What the user should know about the file's values (negative values read as 0).
@@ -45,20 +45,6 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     } else {
         ((c + 0.055) / 1.055).powf(2.4)
     }
-}
-
-/// The standard deviation, in linear units, of the error that rounding a linear value
-/// `linear` to its sRGB encoding's steps of `step` (display units) leaves: `step / sqrt(12)`
-/// through the decoding curve's slope there. Pixels of one value (a lamp's image seen whole)
-/// share that error, so averaging them does not remove it.
-pub fn rounding_sigma(linear: f32, step: f32) -> f32 {
-    let s = linear_to_srgb(linear.clamp(0.0, 1.0));
-    let slope = if s <= 0.04045 {
-        1.0 / 12.92
-    } else {
-        2.4 / 1.055 * ((s + 0.055) / 1.055).powf(1.4)
-    };
-    step / 12f32.sqrt() * slope
 }
 
 /// The exact sRGB encoding curve, the inverse of [`srgb_to_linear`].
@@ -121,8 +107,7 @@ impl Photo {
     }
 
     /// Builds a photo from sRGB-encoded values in [0, 1] (as an 8-bit file would hold them,
-    /// divided by 255: its [`encoding_step`](Self::encoding_step)), marking values at 1 as
-    /// clipped.
+    /// divided by 255: its [`rounding`](Self::rounding)), marking values at 1 as clipped.
     pub fn from_display(width: u32, height: u32, display: Vec<[f32; 3]>, exposure: f32) -> Self {
         let radiance = display
             .iter()
@@ -139,7 +124,7 @@ impl Photo {
             clipped,
             display,
             is_linear_float: false,
-            encoding_step: 1.0 / 255.0,
+            rounding: Rounding::Srgb { step: 1.0 / 255.0 },
             exposure,
             warnings: Vec::new(),
         }
@@ -161,7 +146,7 @@ impl Photo {
             clipped,
             display,
             is_linear_float: true,
-            encoding_step: 0.0,
+            rounding: Rounding::Float,
             exposure,
             warnings: Vec::new(),
         }
@@ -203,7 +188,8 @@ pub fn decode(bytes: &[u8], exposure: f32, path: &Path) -> Result<Photo> {
     let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| Error::io(path, e))?;
-    if reader.format().is_none() {
+    let format = reader.format();
+    if format.is_none() {
         return Err(Error::photo(
             path,
             "not a photo format streaklight reads (PNG, JPEG, TIFF, OpenEXR, Radiance HDR)",
@@ -252,6 +238,9 @@ pub fn decode(bytes: &[u8], exposure: f32, path: &Path) -> Result<Photo> {
     }
     let image = DynamicImage::from_decoder(decoder).map_err(cannot)?;
     let mut photo = from_image(image, exposure).map_err(|message| Error::photo(path, message))?;
+    if format == Some(image::ImageFormat::Hdr) {
+        photo.rounding = Rounding::SharedExponent;
+    }
     for w in &mut photo.warnings {
         *w = format!("{}: {w}", path.display());
     }
@@ -337,7 +326,9 @@ pub fn from_image(image: DynamicImage, exposure: f32) -> std::result::Result<Pho
                 .map(|p| p.0.map(|c| c as f32 / 65535.0))
                 .collect();
             Ok(Photo {
-                encoding_step: 1.0 / 65535.0,
+                rounding: Rounding::Srgb {
+                    step: 1.0 / 65535.0,
+                },
                 ..Photo::from_display(width, height, display, exposure)
             })
         }
@@ -355,36 +346,6 @@ pub fn from_image(image: DynamicImage, exposure: f32) -> std::result::Result<Pho
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Against brute force: the rms error of values spread evenly over a few steps of an
-    /// 8-bit and a 16-bit encoding, rounded to it and decoded.
-    #[test]
-    fn rounding_sigma_is_the_rms_error_of_rounding() {
-        for (linear, step) in [
-            (0.002f32, 1.0 / 255.0),
-            (0.05, 1.0 / 255.0),
-            (0.4, 1.0 / 255.0),
-            (0.7, 1.0 / 255.0),
-            (0.4, 1.0 / 65535.0),
-        ] {
-            let s = linear_to_srgb(linear);
-            let n = 100_000;
-            let mut sum = 0.0f64;
-            for k in 0..n {
-                // Over 4 steps of the encoding around the value.
-                let e = s + step * (4.0 * (k as f32 + 0.5) / n as f32 - 2.0);
-                let rounded = (e / step).round() * step;
-                sum += ((srgb_to_linear(rounded) - srgb_to_linear(e)) as f64).powi(2);
-            }
-            let rms = (sum / n as f64).sqrt() as f32;
-            let got = rounding_sigma(linear, step);
-            assert!(
-                (got / rms - 1.0).abs() < 0.02,
-                "{linear} {step}: {got} against {rms}"
-            );
-        }
-        assert_eq!(rounding_sigma(0.4, 0.0), 0.0);
-    }
 
     #[test]
     fn srgb_curve_round_trips_and_matches_known_points() {

@@ -8,6 +8,7 @@ use std::io::Cursor;
 
 use image::{DynamicImage, ImageBuffer, ImageFormat, Rgb};
 use streaklight::photo_in::{load, srgb_to_linear};
+use streaklight::photo_rounding::Rounding;
 
 /// Linear radiance values to store, including some above 1 (only float formats keep those).
 fn linear_values() -> Vec<[f32; 3]> {
@@ -40,6 +41,13 @@ fn float_formats_are_linear_and_never_clipped() {
         save(img.clone(), &path, format);
         let photo = load(&path, 2.0).unwrap();
         assert!(photo.is_linear_float);
+        // Radiance HDR rounds to 8-bit mantissas under a shared exponent.
+        let rounding = if name == "p.hdr" {
+            Rounding::SharedExponent
+        } else {
+            Rounding::Float
+        };
+        assert_eq!(photo.rounding, rounding, "{name}");
         assert!(
             photo.clipped.iter().all(|&c| !c),
             "{name}: nothing is clipped in a float photo"
@@ -67,6 +75,8 @@ fn integer_formats_are_srgb_with_clipping_at_the_maximum() {
     save(img8, &dir.join("p8.png"), ImageFormat::Png);
     let photo = load(&dir.join("p8.png"), 0.5).unwrap();
     assert!(!photo.is_linear_float);
+    // Its code values are 1/255 apart: the rounding a lamp's image shares.
+    assert_eq!(photo.rounding, Rounding::Srgb { step: 1.0 / 255.0 });
     for (k, px) in photo.radiance.iter().enumerate() {
         let code = [codes[3 * k], codes[3 * k + 1], codes[3 * k + 2]];
         for c in 0..3 {
@@ -86,6 +96,13 @@ fn integer_formats_are_srgb_with_clipping_at_the_maximum() {
     ] {
         save(img16.clone(), &dir.join(name), format);
         let photo = load(&dir.join(name), 1.0).unwrap();
+        assert_eq!(
+            photo.rounding,
+            Rounding::Srgb {
+                step: 1.0 / 65535.0
+            },
+            "{name}"
+        );
         for (k, px) in photo.radiance.iter().enumerate() {
             let code = [codes16[3 * k], codes16[3 * k + 1], codes16[3 * k + 2]];
             for c in 0..3 {

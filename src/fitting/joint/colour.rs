@@ -193,7 +193,7 @@ mod tests {
             set_origin: vec![0],
             inv_samples: 1.0,
             first_direct: n,
-            encoding: (0.0, 1.0),
+            encoding: (crate::photo_rounding::Rounding::Float, 1.0),
         };
         let coef1: Vec<f32> = (0..n).map(|i| ((a[i] + b[i]) / 2.0) as f32).collect();
         let dev1: Vec<f32> = (0..n).map(|i| ((a[i] - b[i]) / 2.0) as f32).collect();

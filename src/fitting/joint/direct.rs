@@ -38,7 +38,6 @@ use super::samples::CAMERA_STRATA;
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::fitting::EdgeSide;
-use crate::photo_in::rounding_sigma;
 use crate::scene_in::Scene;
 
 /// What a probe ray through a pixel corner sees first.
@@ -333,27 +332,39 @@ impl Problem {
     /// Per channel, the variance (radiance units squared) the photo's rounding leaves in a
     /// radiance read off the image of a light of set `set` and rectangle `rect`: the pixels
     /// that see it whole hold one value, rounded alike, so their number does not average the
-    /// rounding away ([`rounding_sigma`] at their median value). 0 for a channel fewer than
-    /// [`MIN_WHOLE_PIXELS`] such pixels measure ([`Problem::measures`]), and for a photo of
-    /// floating-point values.
+    /// rounding away ([`Rounding::sigma`](crate::photo_rounding::Rounding::sigma) at their
+    /// median value). 0 for a channel fewer than [`MIN_WHOLE_PIXELS`] such pixels measure
+    /// ([`Problem::measures`]).
     pub(super) fn shared_rounding(&self, set: usize, rect: &Rect) -> [f64; 3] {
-        let (step, exposure) = self.encoding;
-        if step <= 0.0 || self.first_direct >= self.n() {
-            return [0.0; 3];
-        }
+        let (rounding, exposure) = self.encoding;
         let whole: Vec<usize> = self.seeing_whole(set, rect).collect();
-        std::array::from_fn(|ch| {
-            let mut values: Vec<f32> = whole
-                .iter()
-                .filter(|&&i| self.measures(i, ch))
-                .map(|&i| self.obs[i][ch])
-                .collect();
+        let median = |mut values: Vec<f32>| -> Option<f32> {
             if values.len() < MIN_WHOLE_PIXELS {
-                return 0.0;
+                return None;
             }
             let mid = values.len() / 2;
-            let median = *values.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
-            (rounding_sigma(median * exposure, step) as f64 / exposure as f64).powi(2)
+            Some(*values.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1)
+        };
+        std::array::from_fn(|ch| {
+            let measuring: Vec<usize> = whole
+                .iter()
+                .copied()
+                .filter(|&i| self.measures(i, ch))
+                .collect();
+            let value = median(measuring.iter().map(|&i| self.obs[i][ch]).collect());
+            let brightest = median(
+                measuring
+                    .iter()
+                    .map(|&i| self.obs[i].iter().copied().fold(0.0, f32::max))
+                    .collect(),
+            );
+            match (value, brightest) {
+                (Some(v), Some(b)) => {
+                    let sd = rounding.sigma(v * exposure, b * exposure) / exposure;
+                    (sd as f64).powi(2)
+                }
+                _ => 0.0,
+            }
         })
     }
 

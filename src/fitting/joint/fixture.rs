@@ -117,7 +117,7 @@ impl Table3Light0 {
             set_origin: vec![0],
             inv_samples,
             first_direct: n,
-            encoding: (0.0, 1.0),
+            encoding: (crate::photo_rounding::Rounding::Float, 1.0),
         }
     }
 }

@@ -293,7 +293,7 @@ pub fn fit_joint_with(
             set_origin: (0..planes.len()).collect(),
             inv_samples: 1.0 / per_pixel_samples as f32,
             first_direct,
-            encoding: (photo.encoding_step, photo.exposure),
+            encoding: (photo.rounding, photo.exposure),
         }
     };
     // Rows weighted from the start by a fit before over the same pixels (`row_scales`).

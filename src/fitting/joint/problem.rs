@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::samples::PlaneSamples;
 use crate::fitting::rect::Rect;
+use crate::photo_rounding::Rounding;
 
 /// The fitting problem: observed pixels and every light's stored samples.
 pub(super) struct Problem {
@@ -30,9 +31,9 @@ pub(super) struct Problem {
     /// The fitted pixels from this index on see the lights' walls directly (outside the
     /// water: [`super::direct`]); those before it are water pixels.
     pub(super) first_direct: usize,
-    /// The photo's encoding step and exposure ([`Photo::encoding_step`](crate::photo_in::Photo::encoding_step)):
-    /// the rounding a lamp's image seen whole shares ([`crate::photo_in::rounding_sigma`]).
-    pub(super) encoding: (f32, f32),
+    /// How the photo rounded its values, and its exposure: the rounding a lamp's image seen
+    /// whole shares ([`Problem::shared_rounding`]).
+    pub(super) encoding: (Rounding, f32),
 }
 
 /// The state of a fit: every light's rectangle and radiance, and the coefficients they give.

@@ -204,7 +204,7 @@ mod tests {
             set_origin: vec![0],
             inv_samples: 1.0,
             first_direct: n,
-            encoding: (0.0, 1.0),
+            encoding: (crate::photo_rounding::Rounding::Float, 1.0),
         };
         let st = State {
             set_of: vec![0; lights],

@@ -46,7 +46,7 @@ pub struct Uncertainty {
 /// A parameter's variance in two parts: what the water's pixels give, which the glitter's
 /// correlation grows under the statistical model ([`Uncertainty::widen`]), and the rest,
 /// which it does not: the pixels that see the light directly, the colour ratio of a channel
-/// set from another ([`super::colour`]), the repeats' spread.
+/// set from another (`colour`), the repeats' spread.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct VarianceParts {
     /// From the water's pixels, squared units.
