@@ -27,7 +27,7 @@ pub use water_choice::{
 use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
 use crate::fitting::joint::{
-    fit_joint_with, JointOptions, PixelShare, Split, StartGate, Uncertainty,
+    fit_joint_with, JointOptions, PixelShare, Resume, StartGate, Uncertainty,
 };
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
@@ -219,7 +219,7 @@ pub fn fit(
         },
         timings: Vec::new(),
         modelled: Vec::new(),
-        splits: Vec::new(),
+        resume: Resume::default(),
         stopped_at_start: false,
     };
     let water_model = if observations.is_empty() {
@@ -281,9 +281,8 @@ struct Found {
     timings: Vec<(String, f64)>,
     /// The last joint fit's expected image (its fitted pixels and their modelled radiance).
     modelled: Vec<(u32, [f32; 3])>,
-    /// The start lights the last joint fit explained as two: an overlap refit from the same
-    /// start tries each only that way.
-    splits: Vec<Split>,
+    /// Where the last joint fit ended: an overlap refit from the same start resumes there.
+    resume: Resume,
     /// Whether the last joint fit ended at its start (its start gate said so): no light,
     /// and `modelled` is the start lights' expected image.
     stopped_at_start: bool,
@@ -379,7 +378,7 @@ impl Run<'_> {
         found.lights = outcome.lights_with_statuses();
         found.uncertainties = outcome.uncertainty;
         found.modelled = outcome.modelled;
-        found.splits = outcome.splits;
+        found.resume = outcome.resume;
         found.stopped_at_start = outcome.stopped_at_start;
         found.warnings.extend(outcome.warnings);
         Ok(())
@@ -429,11 +428,11 @@ impl Run<'_> {
             reading.samples,
             reading.share(self.photo.len() as u64).name()
         ));
-        let known = std::mem::take(&mut found.splits);
+        let resume = std::mem::take(&mut found.resume);
         let refit = JointOptions {
             samples: reading.samples,
             pixels: reading.share(self.photo.len() as u64),
-            known_splits: &known,
+            resume: Some(&resume),
             ..*options
         };
         found.reading = Some(reading);
@@ -491,7 +490,7 @@ impl Run<'_> {
         found.warnings.extend(estimate.warnings);
         found.timings = estimate.timings;
         found.modelled = estimate.modelled;
-        found.splits = estimate.splits;
+        found.resume = estimate.resume;
         let at_estimate = JointOptions {
             model: ReflectionModel {
                 gloss: estimate.gloss,
