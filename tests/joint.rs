@@ -13,7 +13,7 @@ use common::pipeline::{
 use streaklight::convert::{convert, ConvertOptions};
 use streaklight::fitting::joint::{fit_joint, JointOptions, JointOutcome, PixelShare, StartGate};
 use streaklight::fitting::FittedLight;
-use streaklight::pipeline::{FitSettings, JointSettings, Method};
+use streaklight::pipeline::{JointSettings, Method};
 use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
 use streaklight::settings::Setting;
@@ -319,12 +319,7 @@ fn stacked_lights_over_smooth_water_within_two_percent() {
                 gloss: Some(samples::STACKED_SMOOTH_GLOSS as f32),
                 ..Default::default()
             },
-            // The paper's estimate as the joint fit's start reads it, so that the outer
-            // edges below compare with the edges the joint fit started from.
-            fit: FitSettings {
-                samples: Some(streaklight::fitting::DEFAULT_START_SAMPLES),
-                ..fit_settings(method, 1, None, false)
-            },
+            fit: fit_settings(method, 1, None, false),
             ..convert_options(
                 sample_scenes(),
                 sample_photo_path("stacked1000.png"),
