@@ -19,14 +19,12 @@ pub const RAYS: u64 = 1 << 36;
 
 /// Refuses `fit`'s options above their caps.
 pub fn fit(args: &super::fit::Args) -> streaklight::Result<()> {
-    if let Some(n) = args.samples {
-        check_cap(
-            "--samples",
-            n.into(),
-            SAMPLES,
-            "the fit's time grows with it",
-        )?;
-    }
+    check_cap(
+        "--samples",
+        args.samples.into(),
+        SAMPLES,
+        "the fit's time grows with it",
+    )?;
     if let Some(n) = args.joint_samples {
         check_cap(
             "--joint-samples",

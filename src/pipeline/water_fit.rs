@@ -229,7 +229,6 @@ impl Run<'_> {
                     self.observations,
                     &FitOptions {
                         model,
-                        samples: self.statistical_samples,
                         ..self.paper
                     },
                 )?;
@@ -269,10 +268,7 @@ impl Run<'_> {
                     self.observations,
                     stats.surface,
                     start,
-                    &FitOptions {
-                        samples: self.statistical_samples,
-                        ..self.paper
-                    },
+                    &self.paper,
                     &final_fit,
                     &slope_search(),
                 )?;
