@@ -12,7 +12,6 @@ use common::pipeline::{
 };
 use streaklight::convert::{convert, ConvertOptions};
 use streaklight::fitting::joint::{fit_joint, JointOptions, JointOutcome, PixelShare, StartGate};
-use streaklight::fitting::FittedLight;
 use streaklight::pipeline::{JointSettings, Method};
 use streaklight::report::{LightReport, Report};
 use streaklight::samples::{self, SampleLight};
@@ -538,21 +537,12 @@ impl PaperStart {
     /// The joint fit from the paper fit's lights with `options` (its model and seed 1 unless
     /// `options` says otherwise).
     fn fit<'a>(&self, options: impl FnOnce(JointOptions<'a>) -> JointOptions<'a>) -> JointOutcome {
-        self.fit_from(&self.paper.lights, options)
-    }
-
-    /// [`Self::fit`] from the lights `start` instead.
-    fn fit_from<'a>(
-        &self,
-        start: &[FittedLight],
-        options: impl FnOnce(JointOptions<'a>) -> JointOptions<'a>,
-    ) -> JointOutcome {
         fit_joint(
             &self.scene,
             &self.photo,
             &self.water,
             &self.observations,
-            start,
+            &self.paper.lights,
             &options(JointOptions::new(self.model, 1)),
         )
         .expect("joint fit")
@@ -637,73 +627,51 @@ fn all_pixels_reads_the_whole_region() {
     );
 }
 
-/// The joint fit reports the lights it explained as two (`JointOutcome::splits`) and where it
-/// ended (`JointOutcome::resume`), and a fit told to resume there (`JointOptions::resume`, as
-/// the overlap refit is) starts from those lights, not from the start: on the stacked sample
-/// from the reflections alone the one start light is split one above the other; resumed
-/// with splits turned off, the fit still has both lights and reports the same split; over
-/// the same samples its boundary search and descent come back to the lights it resumed from
-/// (a fitted optimum is one). A resume from another start is ignored: the fit is as without
-/// it, to the last bit.
+/// The joint fit reports the lights it explained as two (`JointOutcome::splits`), and a fit
+/// told them (`JointOptions::known_splits`, as the overlap refit is told the first fit's)
+/// tries each only that way: on the stacked sample from the reflections alone, the one start
+/// light is split one above the other; told so, the fit makes the same lights to the last
+/// bit (the same samples: only the side-by-side trial is left out); told "side by side", it
+/// never cuts the light the other way.
 #[test]
-fn a_fit_resumes_from_where_another_ended() {
+fn a_known_split_is_tried_only_its_way() {
     use streaklight::fitting::joint::{Split, SplitWay};
     let start = paper_start("stacked.png");
     assert_eq!(start.paper.lights.len(), 1, "the paper fit makes one light");
-    let free = start.fit(|o| JointOptions {
-        samples: 32,
-        direct_view: false,
-        ..o
-    });
+    let fit = |known: &[Split]| {
+        start.fit(|o| JointOptions {
+            samples: 32,
+            direct_view: false,
+            known_splits: known,
+            ..o
+        })
+    };
+    let free = fit(&[]);
     let stacked = Split {
         light: 0,
         way: SplitWay::Stacked,
     };
     assert_eq!(free.splits, [stacked]);
     assert_eq!(free.lights.len(), 2);
-    let resumed = start.fit(|o| JointOptions {
-        samples: 32,
-        direct_view: false,
-        split: false,
-        resume: Some(&free.resume),
-        ..o
-    });
-    assert_eq!(resumed.splits, free.splits);
-    assert_eq!(resumed.lights.len(), 2, "the lights it resumed from");
-    for (a, b) in resumed.lights.iter().zip(&free.lights) {
-        let (ra, rb) = (a.rect(), b.rect());
-        let size = rb.width().max(rb.height());
-        for (ea, eb) in [
-            (ra.u_min, rb.u_min),
-            (ra.u_max, rb.u_max),
-            (ra.v_min, rb.v_min),
-            (ra.v_max, rb.v_max),
-        ] {
-            assert!((ea - eb).abs() < 0.005 * size, "{ra:?} against {rb:?}");
-        }
+    let told = fit(&[stacked]);
+    assert_eq!(told.splits, free.splits);
+    for (a, b) in told.lights.iter().zip(&free.lights) {
+        assert_eq!(
+            (a.rect(), a.radiance),
+            (b.rect(), b.radiance),
+            "the same lights"
+        );
     }
-    // The same resume for a fit of two start lights fits no start of it.
-    let mut two = start.paper.lights.clone();
-    two.push(two[0].clone());
-    let alone = start.fit_from(&two, |o| JointOptions {
-        samples: 32,
-        direct_view: false,
-        sweeps: 2,
-        split: false,
-        ..o
-    });
-    let told = start.fit_from(&two, |o| JointOptions {
-        samples: 32,
-        direct_view: false,
-        sweeps: 2,
-        split: false,
-        resume: Some(&free.resume),
-        ..o
-    });
-    assert_eq!(alone.lights.len(), told.lights.len());
-    for (a, b) in told.lights.iter().zip(&alone.lights) {
-        assert_eq!((a.rect(), a.radiance), (b.rect(), b.radiance));
-    }
+    let side = Split {
+        light: 0,
+        way: SplitWay::SideBySide,
+    };
+    let other = fit(&[side]);
+    assert!(
+        other.splits.iter().all(|s| s.way == SplitWay::SideBySide),
+        "{:?}",
+        other.splits
+    );
 }
 
 /// A start gate (`JointOptions::start_gate`, what the automatic choice of the water model

@@ -27,7 +27,7 @@ pub use water_choice::{
 use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
 use crate::fitting::joint::{
-    fit_joint_with, JointOptions, PixelShare, Resume, StartGate, Uncertainty,
+    fit_joint_with, JointOptions, PixelShare, Split, StartGate, Uncertainty,
 };
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
@@ -218,7 +218,7 @@ pub fn fit(
         },
         timings: Vec::new(),
         modelled: Vec::new(),
-        resume: Resume::default(),
+        splits: Vec::new(),
         stopped_at_start: false,
     };
     let water_model = if observations.is_empty() {
@@ -280,8 +280,9 @@ struct Found {
     timings: Vec<(String, f64)>,
     /// The last joint fit's expected image (its fitted pixels and their modelled radiance).
     modelled: Vec<(u32, [f32; 3])>,
-    /// Where the last joint fit ended: an overlap refit from the same start resumes there.
-    resume: Resume,
+    /// The start lights the last joint fit explained as two: an overlap refit from the same
+    /// start tries each only that way.
+    splits: Vec<Split>,
     /// Whether the last joint fit ended at its start (its start gate said so): no light,
     /// and `modelled` is the start lights' expected image.
     stopped_at_start: bool,
@@ -373,7 +374,7 @@ impl Run<'_> {
         found.lights = outcome.lights_with_statuses();
         found.uncertainties = outcome.uncertainty;
         found.modelled = outcome.modelled;
-        found.resume = outcome.resume;
+        found.splits = outcome.splits;
         found.stopped_at_start = outcome.stopped_at_start;
         found.warnings.extend(outcome.warnings);
         Ok(())
@@ -423,11 +424,11 @@ impl Run<'_> {
             reading.samples,
             reading.share(self.photo.len() as u64).name()
         ));
-        let resume = std::mem::take(&mut found.resume);
+        let known = std::mem::take(&mut found.splits);
         let refit = JointOptions {
             samples: reading.samples,
             pixels: reading.share(self.photo.len() as u64),
-            resume: Some(&resume),
+            known_splits: &known,
             ..*options
         };
         found.reading = Some(reading);
@@ -485,7 +486,7 @@ impl Run<'_> {
         found.warnings.extend(estimate.warnings);
         found.timings = estimate.timings;
         found.modelled = estimate.modelled;
-        found.resume = estimate.resume;
+        found.splits = estimate.splits;
         let at_estimate = JointOptions {
             model: ReflectionModel {
                 gloss: estimate.gloss,

@@ -277,7 +277,7 @@ impl Run<'_> {
                 found.skipped = est.skipped;
                 found.warnings.extend(est.warnings);
                 found.timings.extend(est.timings);
-                found.resume = est.resume;
+                found.splits = est.splits;
                 found.reading = Some(j.reading);
                 let estimated = !found.lights.is_empty();
                 if estimated {

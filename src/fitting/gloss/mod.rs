@@ -110,7 +110,7 @@ pub(super) mod search;
 use std::time::Instant;
 
 use super::joint::{
-    fit_joint, place_starts, JointOptions, ModelledPixel, PixelShare, ProposalCache, Resume,
+    fit_joint, place_starts, JointOptions, ModelledPixel, PixelShare, ProposalCache, Split,
     Uncertainty,
 };
 use super::{fit_paper, FitOptions, FittedLight, Skipped, StreakObservation};
@@ -248,9 +248,9 @@ pub struct GlossEstimate {
     /// The final joint fit's expected image: its fitted water pixels with their modelled
     /// radiance ([`super::joint::JointOutcome::modelled`]).
     pub modelled: Vec<ModelledPixel>,
-    /// Where the final fit ended, for an overlap refit to resume from
-    /// ([`super::joint::JointOutcome::resume`]).
-    pub resume: Resume,
+    /// The start lights the final fit explained as two
+    /// ([`super::joint::JointOutcome::splits`]).
+    pub splits: Vec<Split>,
     /// Whether the search ended at its first fit, whose start gate
     /// ([`JointOptions::start_gate`] of the final fit's options) said so: then there is no
     /// estimate and no light, and `modelled` is that fit's start image.
@@ -365,7 +365,7 @@ pub fn estimate_gloss(
             warnings,
             timings,
             modelled,
-            resume: Resume::default(),
+            splits: Vec::new(),
             stopped_at_start: true,
         });
     }
@@ -432,7 +432,7 @@ pub fn estimate_gloss(
         warnings,
         timings,
         modelled: final_fit.modelled,
-        resume: final_fit.resume,
+        splits: final_fit.splits,
         stopped_at_start: false,
     })
 }

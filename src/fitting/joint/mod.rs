@@ -137,7 +137,7 @@ pub use options::{
     JointOptions, ModelledPixel, PixelShare, StartGate, DEFAULT_JOINT_SAMPLES, LARGE_PHOTO_PIXELS,
     MAX_JOINT_SAMPLES,
 };
-pub use outcome::{JointOutcome, Resume};
+pub use outcome::JointOutcome;
 pub use proposal::{Lobe, ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
 pub use samples::effective_samples;
 pub use split::{Split, SplitWay};
@@ -351,13 +351,7 @@ pub fn fit_joint_with(
     } else {
         0
     };
-    let resume = options.resume.filter(|r| r.fits(start.len()));
-    options.progress.stage(&if let Some(from) = resume {
-        format!(
-            "joint fit: the {} light(s) of the fit before, on these samples",
-            from.rects.len()
-        )
-    } else if held == start.len() {
+    options.progress.stage(&if held == start.len() {
         format!(
             "joint fit: {held} light(s) held where their lamps' images pin them, radiances solved"
         )
@@ -376,35 +370,17 @@ pub fn fit_joint_with(
         )
     });
     let t1 = Instant::now();
-    let fresh_first = |origin, draw| fresh_set(0, origin, draw);
-    let (first, replay, splits) = match resume {
-        // From where a fit before ended: its splits' sets drawn anew, one descent.
-        Some(from) => {
-            let (st, replay) = optimise::resume(
-                &mut problem,
-                from,
-                &mut extents,
-                options.sweeps,
-                &fresh_first,
-                options.progress,
-            );
-            (st, replay, from.splits.clone())
-        }
-        None => {
-            let (first, replay, splits) = optimise(
-                &mut problem,
-                start,
-                &mut extents,
-                options.sweeps,
-                options.split,
-                &fresh_first,
-                options.progress,
-                options.held,
-            );
-            let replay = Resume::of(&problem, &replay, start.len(), &splits);
-            (first, replay, splits)
-        }
-    };
+    let (first, replay, splits) = optimise(
+        &mut problem,
+        start,
+        &mut extents,
+        options.sweeps,
+        options.split,
+        options.known_splits,
+        &|origin, draw| fresh_set(0, origin, draw),
+        options.progress,
+        options.held,
+    );
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
     for repeat in 1..options.repeats {
@@ -418,9 +394,14 @@ pub fn fit_joint_with(
         footprint_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let mut extents: Vec<Option<Rect>> = again.planes.iter().map(sample_extent).collect();
-        let st = again.replay(&replay, &mut extents, options.sweeps, &|origin, draw| {
-            fresh_set(repeat, origin, draw)
-        });
+        let extra_origins = &problem.set_origin[start.len()..];
+        let st = again.replay(
+            &replay,
+            extra_origins,
+            &mut extents,
+            options.sweeps,
+            &|origin, draw| fresh_set(repeat, origin, draw),
+        );
         repeats.push((st.rects, st.radiance));
         optimise_seconds += t.elapsed().as_secs_f64();
     }
@@ -575,7 +556,6 @@ pub fn fit_joint_with(
         ],
         modelled,
         warnings,
-        resume: Resume::of(&problem, &st, start.len(), &splits),
         splits,
         row_scales: scales,
         stopped_at_start: false,

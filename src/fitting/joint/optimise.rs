@@ -12,18 +12,12 @@
 //! light of a split then reads a sample set of its own, drawn independently on the same
 //! plane, and the boundary between the two is searched globally ([`search_boundary`]) before
 //! the final descent. A repeat on other samples ([`Problem::replay`]) starts from where the
-//! last descent started. A refit over other pixels or samples ([`resume`]: the overlap refit)
-//! starts from where a fit ended: its splits' second lights get sets of their own again and
-//! their boundaries are searched again on the new samples, but no light is tried as two
-//! again. On the stacked sample from the reflections alone that saved a quarter of the fit
-//! (the refit's first descent and split trial), the facing edges and radiances as close to
-//! the truth as a refit from the start over 8 seeds (docs/decisions.md).
+//! last descent started.
 
 use super::boundary::{search_boundary, CANDIDATE_SWEEPS};
-use super::outcome::Resume;
 use super::problem::{Problem, State};
 use super::samples::{sample_extent, PlaneSamples};
-use super::split::{try_split, Split};
+use super::split::{try_split, Split, SplitWay};
 use crate::fitting::rect::Rect;
 use crate::fitting::{EdgeSide, EdgeStatus, FittedLight};
 use crate::progress::Reporter;
@@ -34,7 +28,8 @@ use crate::progress::Reporter;
 /// the boundary between the two placed by [`search_boundary`], and another descent. Returns
 /// the optimum and the state its last descent started from (the start, or the split lights
 /// after their boundary search): a repeat on other samples starts there (see
-/// [`Problem::replay`]), and the splits made. `progress` hears each split (so
+/// [`Problem::replay`]), and the splits made. A light of `known` (split by a fit before, from
+/// the same start) is tried only the way that fit cut it. `progress` hears each split (so
 /// that a fit announced with N lights that ends with more says why) and the count of
 /// boundary candidates descended.
 #[allow(clippy::too_many_arguments)]
@@ -44,6 +39,7 @@ pub(super) fn optimise(
     extents: &mut Vec<Option<Rect>>,
     sweeps: u32,
     split: bool,
+    known: &[Split],
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     progress: Reporter<'_>,
     held: &[Option<Rect>],
@@ -77,7 +73,11 @@ pub(super) fn optimise(
             }
         ));
         for k in tried {
-            let Some((trial, way, inner)) = try_split(problem, &st, k, extents) else {
+            let ways = match known.iter().find(|s| s.light == k) {
+                Some(s) => std::slice::from_ref(&s.way),
+                None => &SplitWay::ALL[..],
+            };
+            let Some((trial, way, inner)) = try_split(problem, &st, k, extents, ways) else {
                 continue;
             };
             splits.push(Split { light: k, way });
@@ -92,18 +92,26 @@ pub(super) fn optimise(
             extents.push(sample_extent(&samples));
             let set = problem.add_set(samples, origin);
             problem.move_to_set(&mut st, b, set);
-            st = settle_boundary(
-                problem,
-                st,
-                [k, b],
-                inner,
-                extents,
-                progress,
-                &format!(
-                    "joint fit: the residual of light {k} is structured, as where two lights' \
-                     reflections merge into one streak: split into lights {k} and {b}"
-                ),
-            );
+            let starts = search_boundary(problem, &st, k, b, inner);
+            progress.stage(&format!(
+                "joint fit: the residual of light {k} is structured, as where two lights' \
+                 reflections merge into one streak: split into lights {k} and {b}, their \
+                 boundary searched from {} candidates",
+                starts.len()
+            ));
+            let candidates = starts.len() as u64;
+            let mut best: Option<(State, f64)> = None;
+            for (done, mut cand) in starts.into_iter().enumerate() {
+                progress.advance(done as u64, candidates);
+                problem.descend(&mut cand, extents, CANDIDATE_SWEEPS);
+                let c = problem.cost(&cand);
+                if best.as_ref().is_none_or(|(_, b)| c < *b) {
+                    best = Some((cand, c));
+                }
+            }
+            if let Some((cand, _)) = best {
+                st = cand;
+            }
         }
         if problem.planes.len() > start.len() {
             progress.stage(&format!(
@@ -115,86 +123,6 @@ pub(super) fn optimise(
         }
     }
     (st, replay, splits)
-}
-
-/// Places the boundary between lights `pair`, split from one light (`inner`: the edges that
-/// face each other), by [`search_boundary`], and descends each of its candidates coarsely;
-/// returns the lowest (`st` itself when the search gives none). `progress` hears `what`, with
-/// the count of candidates.
-fn settle_boundary(
-    problem: &Problem,
-    st: State,
-    pair: [usize; 2],
-    inner: [EdgeSide; 2],
-    extents: &[Option<Rect>],
-    progress: Reporter<'_>,
-    what: &str,
-) -> State {
-    let starts = search_boundary(problem, &st, pair[0], pair[1], inner);
-    progress.stage(&format!(
-        "{what}, their boundary searched from {} candidates",
-        starts.len()
-    ));
-    let candidates = starts.len() as u64;
-    let mut best: Option<(State, f64)> = None;
-    for (done, mut cand) in starts.into_iter().enumerate() {
-        progress.advance(done as u64, candidates);
-        problem.descend(&mut cand, extents, CANDIDATE_SWEEPS);
-        let c = problem.cost(&cand);
-        if best.as_ref().is_none_or(|(_, b)| c < *b) {
-            best = Some((cand, c));
-        }
-    }
-    best.map_or(st, |(cand, _)| cand)
-}
-
-/// The fit again from where a fit before ended (`from`, over other pixels or samples: the
-/// overlap refit): the sample sets its splits added drawn anew (`fresh`, as in
-/// [`optimise`]), each split's boundary searched again on these samples
-/// ([`settle_boundary`]), then a descent of every light. No light is tried as two again.
-/// Returns the optimum and the state the descent started from (for repeats).
-pub(super) fn resume(
-    problem: &mut Problem,
-    from: &Resume,
-    extents: &mut Vec<Option<Rect>>,
-    sweeps: u32,
-    fresh: &dyn Fn(usize, u32) -> PlaneSamples,
-    progress: Reporter<'_>,
-) -> (State, Resume) {
-    problem.add_extra_sets(from, extents, fresh);
-    let mut st = problem.state(
-        from.set_of.clone(),
-        from.pinned.clone(),
-        from.rects.clone(),
-        from.radiance.clone(),
-    );
-    for split in &from.splits {
-        // The split's first light reads its start light's set, the second the extra set
-        // drawn on that start light's plane (either may have been dropped since).
-        let first = st.set_of.iter().position(|&s| s == split.light);
-        let second = st
-            .set_of
-            .iter()
-            .position(|&s| s >= from.starts && from.extra_origins[s - from.starts] == split.light);
-        if let (Some(k), Some(b)) = (first, second) {
-            st = settle_boundary(
-                problem,
-                st,
-                [k, b],
-                split.way.inner(),
-                extents,
-                progress,
-                &format!("joint fit: lights {k} and {b}, split from one by the fit before"),
-            );
-        }
-    }
-    progress.stage(&format!(
-        "joint fit: descent of the {} light(s) from where the fit before ended",
-        st.rects.len()
-    ));
-    let replay = Resume::of(problem, &st, from.starts, &from.splits);
-    problem.descend(&mut st, extents, sweeps);
-    (st, replay)
 }
 
 /// The state a fit starts from: the `start` lights, each inside its samples' extent, with an
@@ -244,18 +172,23 @@ pub(super) fn start_state(
 }
 
 impl Problem {
-    /// A descent from the lights `from` on this problem's samples: a repeat of the fit that
-    /// `optimise` made, from the state its last descent started from, or a refit from where
-    /// a fit ended ([`Resume`]). The extra sample sets (one per light a split added, on start
-    /// light `from.extra_origins[j]`'s plane) `fresh` draws anew, as in [`optimise`].
+    /// The fit that `optimise` made, repeated on this problem's samples: from `from`, the
+    /// state its last descent started from, whose extra sample sets (one per light a split
+    /// added, on start light `extra_origins[j]`'s plane) `fresh` draws anew, as in
+    /// [`optimise`].
     pub(super) fn replay(
         &mut self,
-        from: &Resume,
+        from: &State,
+        extra_origins: &[usize],
         extents: &mut Vec<Option<Rect>>,
         sweeps: u32,
         fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     ) -> State {
-        self.add_extra_sets(from, extents, fresh);
+        for (draw, &origin) in extra_origins.iter().enumerate() {
+            let samples = fresh(origin, draw as u32 + 1);
+            extents.push(sample_extent(&samples));
+            self.add_set(samples, origin);
+        }
         let mut st = self.state(
             from.set_of.clone(),
             from.pinned.clone(),
@@ -264,39 +197,5 @@ impl Problem {
         );
         self.descend(&mut st, extents, sweeps);
         st
-    }
-}
-
-impl Problem {
-    /// The sample sets `from`'s splits added (one per light a split added, on start light
-    /// `from.extra_origins[j]`'s plane), drawn anew by `fresh`, their extents after
-    /// `extents`.
-    fn add_extra_sets(
-        &mut self,
-        from: &Resume,
-        extents: &mut Vec<Option<Rect>>,
-        fresh: &dyn Fn(usize, u32) -> PlaneSamples,
-    ) {
-        for (draw, &origin) in from.extra_origins.iter().enumerate() {
-            let samples = fresh(origin, draw as u32 + 1);
-            extents.push(sample_extent(&samples));
-            self.add_set(samples, origin);
-        }
-    }
-}
-
-impl Resume {
-    /// The lights of `st`, a state of `problem` from `starts` start lights, and the splits
-    /// that made them.
-    pub(super) fn of(problem: &Problem, st: &State, starts: usize, splits: &[Split]) -> Self {
-        Resume {
-            starts,
-            set_of: st.set_of.clone(),
-            extra_origins: problem.set_origin[starts..].to_vec(),
-            pinned: st.pinned.clone(),
-            rects: st.rects.clone(),
-            radiance: st.radiance.clone(),
-            splits: splits.to_vec(),
-        }
     }
 }

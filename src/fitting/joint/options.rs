@@ -1,7 +1,7 @@
 //! The joint fit's options ([`JointOptions`]) and the limits on its samples.
 
 use super::proposal::Reweight;
-use super::Resume;
+use super::Split;
 use crate::fitting::rect::Rect;
 use crate::optics::ReflectionModel;
 use crate::progress::Reporter;
@@ -29,11 +29,10 @@ pub struct JointOptions<'a> {
     /// Try explaining each light as two (overlapping streaks), keeping the split when it
     /// fits the photo far better.
     pub split: bool,
-    /// A fit before from the same start on the same photo, whose lights this fit descends
-    /// from rather than from the start (an overlap refit over more pixels and samples): the
-    /// sample sets that fit's splits added are drawn anew, and no split is tried again.
-    /// `None` by default, and ignored unless it [fits](Resume::fits) the start.
-    pub resume: Option<&'a Resume>,
+    /// Lights a fit before split, from the same start on the same photo: each is tried only
+    /// the way that fit cut it (an overlap refit over more samples saves the other way's
+    /// trial). Empty by default.
+    pub known_splits: &'a [Split],
     /// The gloss whose lobe decides which pixels around the streaks are fitted (`None`: the
     /// model's). Fits under different glosses are comparable only over the same pixels, so a
     /// gloss search fixes it to the broadest lobe it will try.
@@ -127,7 +126,7 @@ impl JointOptions<'_> {
             sweeps: 14,
             pixels: PixelShare::Checkerboard,
             split: true,
-            resume: None,
+            known_splits: &[],
             region_gloss: None,
             region_water: None,
             repeats: 1,

@@ -30,11 +30,9 @@ pub struct JointOutcome {
     /// Things the user should know: the lights dropped because the photo cannot tell them
     /// from nothing (`significance`), with why.
     pub warnings: Vec<String>,
-    /// The start lights the fit explained as two, and which way.
+    /// The start lights the fit explained as two, and which way
+    /// ([`JointOptions::known_splits`](super::JointOptions::known_splits) of a refit).
     pub splits: Vec<Split>,
-    /// Where the fit ended, for a refit over other pixels or samples to resume from
-    /// ([`JointOptions::resume`](super::JointOptions::resume)).
-    pub resume: Resume,
     /// Per fitted pixel, the scale its row was weighted by (`glitter`), when it was.
     pub row_scales: Option<Vec<f32>>,
     /// Whether the fit ended at its start, as its
@@ -50,40 +48,6 @@ pub struct JointOutcome {
     pub seen_whole: Vec<Option<Rect>>,
 }
 
-/// The lights of a joint fit as it ended, on its start lights' planes: what a refit from the
-/// same start over other pixels or samples ([`JointOptions::resume`](super::JointOptions::resume))
-/// descends from, drawing anew the sample sets the fit's splits added.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Resume {
-    /// How many start lights the fit had: a refit must start from as many.
-    pub(super) starts: usize,
-    /// Per light, the sample set it reads: a start light's (below `starts`) or a split's.
-    pub(super) set_of: Vec<usize>,
-    /// Per sample set a split added (set `starts + j`), the start light it was drawn on.
-    pub(super) extra_origins: Vec<usize>,
-    /// Per light and edge: held where it is.
-    pub(super) pinned: Vec<[bool; 4]>,
-    /// Per light, its rectangle.
-    pub(super) rects: Vec<Rect>,
-    /// Per light, its radiance.
-    pub(super) radiance: Vec<[f64; 3]>,
-    /// The splits the fit made, reported again by the refit.
-    pub(super) splits: Vec<Split>,
-}
-
-impl Resume {
-    /// Whether it has lights to resume from `starts` start lights with.
-    pub fn fits(&self, starts: usize) -> bool {
-        !self.rects.is_empty()
-            && self.starts == starts
-            && self.extra_origins.iter().all(|&o| o < starts)
-            && self
-                .set_of
-                .iter()
-                .all(|&s| s < starts + self.extra_origins.len())
-    }
-}
-
 impl JointOutcome {
     /// The outcome of a fit that fitted nothing.
     pub(super) fn empty() -> Self {
@@ -97,7 +61,6 @@ impl JointOutcome {
             modelled: Vec::new(),
             warnings: Vec::new(),
             splits: Vec::new(),
-            resume: Resume::default(),
             row_scales: None,
             stopped_at_start: false,
             seen_whole: Vec::new(),

@@ -28,15 +28,6 @@ pub enum SplitWay {
 impl SplitWay {
     /// Both ways, in the order they are tried.
     pub const ALL: [SplitWay; 2] = [SplitWay::Stacked, SplitWay::SideBySide];
-
-    /// The two edges that face each other across the cut: the first light's, then the
-    /// second's.
-    pub(super) fn inner(self) -> [EdgeSide; 2] {
-        match self {
-            SplitWay::Stacked => [EdgeSide::Top, EdgeSide::Bottom],
-            SplitWay::SideBySide => [EdgeSide::Right, EdgeSide::Left],
-        }
-    }
 }
 
 /// A light that a joint fit explained as two: its index among the fit's start lights, and
@@ -49,8 +40,8 @@ pub struct Split {
     pub way: SplitWay,
 }
 
-/// Tries to explain light k as two lights on its plane, each way (one above the other, side
-/// by side; overlapping streaks merge into one region, method §5 and the paper's
+/// Tries to explain light k as two lights on its plane, each way of `ways` (one above the
+/// other, side by side; overlapping streaks merge into one region, method §5 and the paper's
 /// §5.3): each candidate starts from the rectangle cut in half and is fitted coarsely, the
 /// other lights held. Returns the candidate with the lowest row-summed cost when it is below
 /// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, its way, and the two edges that
@@ -62,16 +53,23 @@ pub(super) fn try_split(
     st: &State,
     k: usize,
     extents: &[Option<Rect>],
+    ways: &[SplitWay],
 ) -> Option<(State, SplitWay, [EdgeSide; 2])> {
     let r = st.rects[k];
     let mut best: Option<(State, SplitWay, [EdgeSide; 2], f64)> = None;
-    for way in SplitWay::ALL {
-        let inner = way.inner();
-        let middle = match way {
-            SplitWay::Stacked => 0.5 * (r.v_min + r.v_max),
-            SplitWay::SideBySide => 0.5 * (r.u_min + r.u_max),
+    for &way in ways {
+        let (first, second, inner) = match way {
+            SplitWay::Stacked => (
+                r.with_edge(EdgeSide::Top, 0.5 * (r.v_min + r.v_max)),
+                r.with_edge(EdgeSide::Bottom, 0.5 * (r.v_min + r.v_max)),
+                [EdgeSide::Top, EdgeSide::Bottom],
+            ),
+            SplitWay::SideBySide => (
+                r.with_edge(EdgeSide::Right, 0.5 * (r.u_min + r.u_max)),
+                r.with_edge(EdgeSide::Left, 0.5 * (r.u_min + r.u_max)),
+                [EdgeSide::Right, EdgeSide::Left],
+            ),
         };
-        let (first, second) = (r.with_edge(inner[0], middle), r.with_edge(inner[1], middle));
         let mut set_of = st.set_of.clone();
         let mut pinned = st.pinned.clone();
         let mut rects = st.rects.clone();

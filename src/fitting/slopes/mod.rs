@@ -50,7 +50,7 @@ pub use uncertainty::{
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
 use super::joint::{
-    fit_joint_with, place_starts, JointOptions, Lobe, ProposalCache, Resume, Reweight, Uncertainty,
+    fit_joint_with, place_starts, JointOptions, Lobe, ProposalCache, Reweight, Split, Uncertainty,
 };
 use super::{fit_paper_with, FitOptions, FittedLight, Rect, Skipped, StreakObservation};
 use crate::optics::{GaussianSlopes, ReflectionModel};
@@ -121,9 +121,9 @@ pub struct SlopeEstimate {
     /// The final fit's residual correlation area, pixels per independent residual
     /// ([`correlation_area`]): the uncertainties are grown by its square root.
     pub correlation_area: f64,
-    /// Where the final fit ended, for an overlap refit to resume from
-    /// ([`super::joint::JointOutcome::resume`]).
-    pub resume: Resume,
+    /// The start lights the final fit explained as two
+    /// ([`super::joint::JointOutcome::splits`]).
+    pub splits: Vec<Split>,
 }
 
 /// Estimates the slope variances over `surface` from the start `start_variance` (totals,
@@ -183,7 +183,7 @@ pub fn estimate_slopes(
             timings,
             cost: 0.0,
             correlation_area: 1.0,
-            resume: Resume::default(),
+            splits: Vec::new(),
         });
     }
     let start = search_start(&paper_fit, streaks.len(), "waves' slope")?;
@@ -418,7 +418,7 @@ pub fn estimate_slopes(
         timings,
         cost: fit.cost,
         correlation_area: area,
-        resume: fit.resume,
+        splits: fit.splits,
     })
 }
 
