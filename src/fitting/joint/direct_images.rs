@@ -30,6 +30,10 @@ pub(super) struct DirectImage {
     /// anything in front of the wall cuts the image, which may then hide part of the light.
     /// For the image chosen for a start: and so are all the others the start overlaps.
     pub(super) enclosed: bool,
+    /// Per side of `rect` (left, right, bottom, top): whether the frame's border, the water or
+    /// anything in front cuts the image there (most of the group's pixels along that side
+    /// have a neighbour that does not see the plane), so that the light may reach beyond it.
+    pub(super) cut: [bool; 4],
     /// For the image chosen for a start: the bounding rectangle of every image the start
     /// overlaps, what the start is trimmed to (two stacked lamps are two images under one
     /// start).
@@ -97,20 +101,18 @@ pub(super) fn images_in(
     let bright: Vec<&(usize, Vec2, f32, f32)> = seen.iter().filter(|s| s.3 >= threshold).collect();
     let groups = groups_8(&bright.iter().map(|s| s.0).collect::<Vec<_>>(), w as usize);
     let sees_plane: std::collections::HashSet<usize> = seen.iter().map(|s| s.0).collect();
-    // Every 8-neighbour of the group's pixels is in the frame and sees the plane.
-    let enclosed = |g: &[usize]| {
-        g.iter().all(|&m| {
-            let p = bright[m].0;
-            let (x, y) = ((p % w as usize) as i64, (p / w as usize) as i64);
-            (-1..=1i64).all(|dy| {
-                (-1..=1i64).all(|dx| {
-                    let (nx, ny) = (x + dx, y + dy);
-                    nx >= 0
-                        && ny >= 0
-                        && nx < w as i64
-                        && ny < h as i64
-                        && sees_plane.contains(&(ny as usize * w as usize + nx as usize))
-                })
+    // Whether every 8-neighbour of group pixel m is in the frame and sees the plane.
+    let surrounded = |m: usize| {
+        let p = bright[m].0;
+        let (x, y) = ((p % w as usize) as i64, (p / w as usize) as i64);
+        (-1..=1i64).all(|dy| {
+            (-1..=1i64).all(|dx| {
+                let (nx, ny) = (x + dx, y + dy);
+                nx >= 0
+                    && ny >= 0
+                    && nx < w as i64
+                    && ny < h as i64
+                    && sees_plane.contains(&(ny as usize * w as usize + nx as usize))
             })
         })
     };
@@ -136,10 +138,33 @@ pub(super) fn images_in(
                 t_sum += t;
             }
             let half_pixel = 0.5 * pixel_angle * t_sum / g.len() as f32;
+            // Per side, its pixels within half a footprint of it (its own row or column of
+            // the image) and how many of those are not
+            // surrounded: a side most of whose pixels are not is cut (a corner pixel of a
+            // side the frame cuts lies on the neighbouring side too).
+            let mut along = [(0usize, 0usize); 4];
+            for &m in &g {
+                let q = bright[m].1;
+                let open = !surrounded(m);
+                let gaps = [
+                    q.x - rect.u_min,
+                    rect.u_max - q.x,
+                    q.y - rect.v_min,
+                    rect.v_max - q.y,
+                ];
+                for (count, gap) in along.iter_mut().zip(gaps) {
+                    if gap <= half_pixel {
+                        count.0 += 1;
+                        count.1 += open as usize;
+                    }
+                }
+            }
+            let cut = along.map(|(all, open)| 2 * open > all);
             DirectImage {
                 first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
                 rect: rect.grow(half_pixel),
-                enclosed: enclosed(&g),
+                enclosed: g.iter().all(|&m| surrounded(m)),
+                cut,
                 reach: rect.grow(half_pixel),
                 footprint: 2.0 * half_pixel,
             }

@@ -66,11 +66,31 @@ pub(crate) fn direct_starts(
                 out[k].streak_ids.extend(light.streak_ids.iter().copied());
             }
             _ => {
+                // Onto the image, but where the image is cut (by the frame, the water or
+                // something in front) the light may go on beyond it: there the start keeps
+                // its own extent if it reaches further.
                 let mut moved = light.clone();
-                moved.u_min = im.rect.u_min;
-                moved.u_max = im.rect.u_max;
-                moved.v_min = im.rect.v_min;
-                moved.v_max = im.rect.v_max;
+                let [left, right, bottom, top] = im.cut;
+                moved.u_min = if left {
+                    light.u_min.min(im.rect.u_min)
+                } else {
+                    im.rect.u_min
+                };
+                moved.u_max = if right {
+                    light.u_max.max(im.rect.u_max)
+                } else {
+                    im.rect.u_max
+                };
+                moved.v_min = if bottom {
+                    light.v_min.min(im.rect.v_min)
+                } else {
+                    im.rect.v_min
+                };
+                moved.v_max = if top {
+                    light.v_max.max(im.rect.v_max)
+                } else {
+                    im.rect.v_max
+                };
                 on_image.push(Some(im.first_pixel));
                 out.push(moved);
             }

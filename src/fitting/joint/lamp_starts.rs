@@ -278,6 +278,7 @@ mod tests {
             first_pixel: 0,
             rect: r,
             enclosed: true,
+            cut: [false; 4],
             reach: r,
             footprint: 0.01,
         }
