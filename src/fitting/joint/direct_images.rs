@@ -139,9 +139,9 @@ pub(super) fn images_in(
             }
             let half_pixel = 0.5 * pixel_angle * t_sum / g.len() as f32;
             // Per side, its pixels within half a footprint of it (its own row or column of
-            // the image) and how many of those are not
-            // surrounded: a side most of whose pixels are not is cut (a corner pixel of a
-            // side the frame cuts lies on the neighbouring side too).
+            // the image) and how many of those are not surrounded: a side most of whose
+            // pixels are not is cut (a corner pixel of a side the frame cuts lies on the
+            // neighbouring side too).
             let mut along = [(0usize, 0usize); 4];
             for &m in &g {
                 let q = bright[m].1;

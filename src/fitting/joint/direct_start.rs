@@ -71,26 +71,17 @@ pub(crate) fn direct_starts(
                 // its own extent if it reaches further.
                 let mut moved = light.clone();
                 let [left, right, bottom, top] = im.cut;
-                moved.u_min = if left {
-                    light.u_min.min(im.rect.u_min)
-                } else {
-                    im.rect.u_min
+                let edge = |cut: bool, own: f32, image: f32, further: fn(f32, f32) -> f32| {
+                    if cut {
+                        further(own, image)
+                    } else {
+                        image
+                    }
                 };
-                moved.u_max = if right {
-                    light.u_max.max(im.rect.u_max)
-                } else {
-                    im.rect.u_max
-                };
-                moved.v_min = if bottom {
-                    light.v_min.min(im.rect.v_min)
-                } else {
-                    im.rect.v_min
-                };
-                moved.v_max = if top {
-                    light.v_max.max(im.rect.v_max)
-                } else {
-                    im.rect.v_max
-                };
+                moved.u_min = edge(left, light.u_min, im.rect.u_min, f32::min);
+                moved.u_max = edge(right, light.u_max, im.rect.u_max, f32::max);
+                moved.v_min = edge(bottom, light.v_min, im.rect.v_min, f32::min);
+                moved.v_max = edge(top, light.v_max, im.rect.v_max, f32::max);
                 on_image.push(Some(im.first_pixel));
                 out.push(moved);
             }
