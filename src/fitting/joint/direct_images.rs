@@ -142,10 +142,10 @@ pub(super) fn images_in(
             // the image) and how many of those are not surrounded: a side most of whose
             // pixels are not is cut (a corner pixel of a side the frame cuts lies on the
             // neighbouring side too).
+            let open: Vec<bool> = g.iter().map(|&m| !surrounded(m)).collect();
             let mut along = [(0usize, 0usize); 4];
-            for &m in &g {
+            for (&m, &open) in g.iter().zip(&open) {
                 let q = bright[m].1;
-                let open = !surrounded(m);
                 let gaps = [
                     q.x - rect.u_min,
                     rect.u_max - q.x,
@@ -163,7 +163,7 @@ pub(super) fn images_in(
             DirectImage {
                 first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
                 rect: rect.grow(half_pixel),
-                enclosed: g.iter().all(|&m| surrounded(m)),
+                enclosed: !open.contains(&true),
                 cut,
                 reach: rect.grow(half_pixel),
                 footprint: 2.0 * half_pixel,
