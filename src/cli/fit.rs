@@ -87,9 +87,11 @@ pub struct Args {
     #[arg(long, value_name = "E|auto", default_value = "1", value_parser = super::values::exposure)]
     pub exposure: ExposureArg,
     /// Lobe samples per traced pixel of the per-streak estimate (1 or more; typical 64-2048;
-    /// its time grows in proportion).
-    #[arg(long, value_name = "N", default_value_t = streaklight::fitting::DEFAULT_SAMPLES, value_parser = super::values::count)]
-    pub samples: u32,
+    /// its time grows in proportion). Default: 512 where the estimate is the result (--method
+    /// paper) or the statistical water model's start, 128 where it starts the exact model's
+    /// joint fit (which moves every edge from there).
+    #[arg(long, value_name = "N", value_parser = super::values::count)]
+    pub samples: Option<u32>,
     /// Seed of every random number, 0 to 2^64-1: the same inputs and seed give the same
     /// output.
     #[arg(long, default_value_t = 1, value_parser = super::values::seed)]

@@ -195,8 +195,9 @@ pub fn fit(
         photo,
         water: &water,
         observations: &observations,
+        statistical_samples: settings.paper_samples(true),
         paper: FitOptions {
-            samples: settings.samples,
+            samples: settings.paper_samples(false),
             seed: settings.seed,
             model: ReflectionModel {
                 gloss: scene.water.gloss,
@@ -308,8 +309,12 @@ struct Run<'a> {
     photo: &'a Photo,
     water: &'a [bool],
     observations: &'a [StreakObservation],
-    /// The paper's estimate's options; their model and seed are every fit's.
+    /// The paper's estimate's options under the exact model; their model and seed are every
+    /// fit's.
     paper: FitOptions,
+    /// The paper's estimate's samples per traced pixel under the statistical model
+    /// ([`FitSettings::paper_samples`]).
+    statistical_samples: u32,
     progress: Reporter<'a>,
 }
 

@@ -5,7 +5,7 @@
 use super::water_choice::WaterChoice;
 use crate::fitting::gloss::GlossSearch;
 use crate::fitting::joint::{PixelShare, DEFAULT_JOINT_SAMPLES};
-use crate::fitting::DEFAULT_SAMPLES;
+use crate::fitting::{DEFAULT_SAMPLES, DEFAULT_START_SAMPLES};
 use crate::optics::Shadowing;
 use crate::settings::Setting;
 use crate::streaks::StreakParams;
@@ -14,9 +14,11 @@ use crate::{Error, Result};
 /// Everything [`super::fit`] needs besides the scene and the photo.
 #[derive(Clone, Debug)]
 pub struct FitSettings {
-    /// Lobe samples per traced pixel of the paper's estimate (method §5 steps 7-9). The edge
+    /// Lobe samples per traced pixel of the paper's estimate (method §5 steps 7-9); `None`:
+    /// [`DEFAULT_SAMPLES`], or [`DEFAULT_START_SAMPLES`] where the estimate starts the exact
+    /// model's joint fit ([`Self::paper_samples`]). The edge
     /// solutions average over tens of pixels, so a few hundred suffice.
-    pub samples: u32,
+    pub samples: Option<u32>,
     /// Seed of every random number of the fit: the same inputs and seed give the same lights.
     pub seed: u64,
     /// Shadowing term of the reflection model (method §4).
@@ -34,12 +36,12 @@ pub struct FitSettings {
 }
 
 impl Default for FitSettings {
-    /// The defaults of `streaklight fit`: [`DEFAULT_SAMPLES`] samples, seed 1, the paper's
+    /// The defaults of `streaklight fit`: the paper's estimate's samples by its use, seed 1, the paper's
     /// G = 1, the default streak extraction, the joint method with the scene's gloss, the
     /// water model chosen from the photo, the night's background taken off.
     fn default() -> Self {
         FitSettings {
-            samples: DEFAULT_SAMPLES,
+            samples: None,
             seed: 1,
             shadowing: Shadowing::None,
             streaks: StreakParams::default(),
@@ -195,9 +197,22 @@ pub enum GlossFit {
 }
 
 impl FitSettings {
+    /// The paper's estimate's samples per traced pixel under the water model `statistical`
+    /// or the exact one: the ones asked for, else [`DEFAULT_START_SAMPLES`] where the
+    /// estimate starts the exact model's joint fit and [`DEFAULT_SAMPLES`] where it is the
+    /// result (the paper's method) or starts the statistical model's slope search (out of
+    /// frame its fits descend from the start, and its noise moved their lights by tens of
+    /// percent: docs/decisions.md).
+    pub fn paper_samples(&self, statistical: bool) -> u32 {
+        self.samples.unwrap_or(match self.method {
+            Method::Joint(_) if !statistical => DEFAULT_START_SAMPLES,
+            _ => DEFAULT_SAMPLES,
+        })
+    }
+
     /// Refuses values out of range, naming the setting.
     pub fn validate(&self) -> Result<()> {
-        if self.samples == 0 {
+        if self.samples == Some(0) {
             return Err(Error::setting(Setting::Samples, "must be at least 1"));
         }
         if let Method::Joint(joint) = &self.method {
@@ -234,10 +249,35 @@ mod tests {
         }
     }
 
+    /// The paper's estimate reads 128 samples where it only starts the exact model's joint
+    /// fit, 512 where it is the result or the statistical model's start, and what was asked
+    /// for wherever it was asked.
+    #[test]
+    fn the_paper_estimates_samples_follow_its_use() {
+        let joint = FitSettings::default();
+        assert_eq!(joint.paper_samples(false), 128);
+        assert_eq!(joint.paper_samples(true), 512);
+        let paper = FitSettings {
+            method: Method::Paper,
+            ..FitSettings::default()
+        };
+        assert_eq!(paper.paper_samples(false), 512);
+        assert_eq!(paper.paper_samples(true), 512);
+        for method in [Method::Paper, Method::default()] {
+            let asked = FitSettings {
+                samples: Some(64),
+                method,
+                ..FitSettings::default()
+            };
+            assert_eq!(asked.paper_samples(false), 64);
+            assert_eq!(asked.paper_samples(true), 64);
+        }
+    }
+
     #[test]
     fn zero_samples_are_refused_by_name() {
         let no_samples = FitSettings {
-            samples: 0,
+            samples: Some(0),
             ..FitSettings::default()
         };
         let e = no_samples.validate().unwrap_err();

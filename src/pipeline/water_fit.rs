@@ -229,6 +229,7 @@ impl Run<'_> {
                     self.observations,
                     &FitOptions {
                         model,
+                        samples: self.statistical_samples,
                         ..self.paper
                     },
                 )?;
@@ -268,7 +269,10 @@ impl Run<'_> {
                     self.observations,
                     stats.surface,
                     start,
-                    &self.paper,
+                    &FitOptions {
+                        samples: self.statistical_samples,
+                        ..self.paper
+                    },
                     &final_fit,
                     &slope_search(),
                 )?;

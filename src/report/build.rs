@@ -59,7 +59,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
                 Shadowing::None => "none".into(),
                 Shadowing::Smith => "smith".into(),
             },
-            samples: settings.samples,
+            samples: settings.paper_samples(lit.water_model.model == "statistical"),
             seed: settings.seed,
             repeats: joint.map_or(1, |j| j.repeats),
             joint_samples: lit.reading.map(|r| effective_samples(r.samples)),

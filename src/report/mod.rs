@@ -81,7 +81,8 @@ pub struct Settings {
     pub ior: f32,
     /// Shadowing term: "none" (G = 1, capped at grazing) or "smith".
     pub shadowing: String,
-    /// Lobe samples per pixel.
+    /// Lobe samples per traced pixel of the paper's estimate under the water model used
+    /// ([`crate::pipeline::FitSettings::paper_samples`]).
     pub samples: u32,
     /// Seed of every random number.
     pub seed: u64,
