@@ -101,9 +101,9 @@ fn pitched_down(dir: &Path, file: &str, degrees: f64, name: &str) -> PathBuf {
 /// each lamp lit. Held: two lights, neither seen directly, every edge within 2 % of its
 /// light's size and every radiance channel within 3 % of its own value, every error the report
 /// gives a sigma for within 3 of them, and the warning that the reflections alone tell such
-/// lights apart only weakly (measured: edges within 0.7 %, channels within 2.2 %: the blue
-/// lamp's weak red, 3 of its 20, set from its colour, 2.2 % low at 2.7 sigma, its blue 1.1 %
-/// low at 1.4). Read by least squares alone, that red channel came out 3.0 % low at 3.4
+/// lights apart only weakly (measured: edges within 0.7 %, channels within 2.1 %: the blue
+/// lamp's weak red, 3 of its 20, set from its colour, 2.0 % low at 2.4 sigma, its blue 0.9 %
+/// low at 1.1). Read by least squares alone, that red channel came out 3.0 % low at 3.4
 /// sigmas: the orange lamp's modelled tail over the pixels they share was taken from it.
 #[test]
 fn orange_and_blue_lamps_out_of_frame_are_split_by_their_colours() {
