@@ -196,6 +196,7 @@ pub fn fit(
         water: &water,
         observations: &observations,
         statistical_samples: settings.paper_samples(true),
+        quick_statistical_samples: settings.quick_statistical_samples(),
         paper: FitOptions {
             samples: settings.paper_samples(false),
             seed: settings.seed,
@@ -315,6 +316,9 @@ struct Run<'a> {
     /// The paper's estimate's samples per traced pixel under the statistical model
     /// ([`FitSettings::paper_samples`]).
     statistical_samples: u32,
+    /// The samples of the statistical start's first try
+    /// ([`FitSettings::quick_statistical_samples`]).
+    quick_statistical_samples: Option<u32>,
     progress: Reporter<'a>,
 }
 

@@ -202,12 +202,24 @@ impl FitSettings {
     /// estimate starts the exact model's joint fit and [`DEFAULT_SAMPLES`] where it is the
     /// result (the paper's method) or starts the statistical model's slope search (out of
     /// frame its fits descend from the start, and its noise moved their lights by tens of
-    /// percent: docs/decisions.md).
+    /// percent: docs/decisions.md), unless [`Self::quick_statistical_samples`]' first try is
+    /// kept.
     pub fn paper_samples(&self, statistical: bool) -> u32 {
         self.samples.unwrap_or(match self.method {
             Method::Joint(_) if !statistical => DEFAULT_START_SAMPLES,
             _ => DEFAULT_SAMPLES,
         })
+    }
+
+    /// The samples per traced pixel of a first, cheaper estimate the statistical model's
+    /// slope search tries as its start: kept when every light it starts lies on a lamp's
+    /// whole direct image, which then pins it ([`crate::fitting::slopes::estimate_slopes`]).
+    /// [`DEFAULT_START_SAMPLES`] for the joint method unless `--samples` was given.
+    pub fn quick_statistical_samples(&self) -> Option<u32> {
+        match self.method {
+            Method::Joint(_) if self.samples.is_none() => Some(DEFAULT_START_SAMPLES),
+            _ => None,
+        }
     }
 
     /// Refuses values out of range, naming the setting.
@@ -257,12 +269,14 @@ mod tests {
         let joint = FitSettings::default();
         assert_eq!(joint.paper_samples(false), 128);
         assert_eq!(joint.paper_samples(true), 512);
+        assert_eq!(joint.quick_statistical_samples(), Some(128));
         let paper = FitSettings {
             method: Method::Paper,
             ..FitSettings::default()
         };
         assert_eq!(paper.paper_samples(false), 512);
         assert_eq!(paper.paper_samples(true), 512);
+        assert_eq!(paper.quick_statistical_samples(), None);
         for method in [Method::Paper, Method::default()] {
             let asked = FitSettings {
                 samples: Some(64),
@@ -271,6 +285,7 @@ mod tests {
             };
             assert_eq!(asked.paper_samples(false), 64);
             assert_eq!(asked.paper_samples(true), 64);
+            assert_eq!(asked.quick_statistical_samples(), None);
         }
     }
 

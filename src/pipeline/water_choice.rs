@@ -132,6 +132,8 @@ pub struct SlopesUsed {
     /// Pixels per independent residual of the final fit (the glitter's correlation area):
     /// every uncertainty was grown by its square root; `None` for the paper's method.
     pub correlation_area: Option<f64>,
+    /// Lobe samples per traced pixel of the paper's estimate the fit started from.
+    pub start_samples: u32,
 }
 
 /// The fine structure of the photo and of a model over the fitted pixels `modelled` (indices

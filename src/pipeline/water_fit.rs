@@ -244,6 +244,7 @@ impl Run<'_> {
                     start_source,
                     estimated: false,
                     correlation_area: None,
+                    start_samples: self.statistical_samples,
                 }
             }
             Method::Joint(j) => {
@@ -273,6 +274,7 @@ impl Run<'_> {
                         samples: self.statistical_samples,
                         ..self.paper
                     },
+                    self.quick_statistical_samples,
                     &final_fit,
                     &slope_search(),
                 )?;
@@ -294,6 +296,7 @@ impl Run<'_> {
                     start_source,
                     estimated,
                     correlation_area: Some(est.correlation_area),
+                    start_samples: est.start_samples,
                 }
             }
         };

@@ -59,7 +59,11 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
                 Shadowing::None => "none".into(),
                 Shadowing::Smith => "smith".into(),
             },
-            samples: settings.paper_samples(lit.water_model.model == "statistical"),
+            samples: lit
+                .water_model
+                .slopes
+                .as_ref()
+                .map_or(settings.paper_samples(false), |s| s.start_samples),
             seed: settings.seed,
             repeats: joint.map_or(1, |j| j.repeats),
             joint_samples: lit.reading.map(|r| effective_samples(r.samples)),

@@ -81,8 +81,9 @@ pub struct Settings {
     pub ior: f32,
     /// Shadowing term: "none" (G = 1, capped at grazing) or "smith".
     pub shadowing: String,
-    /// Lobe samples per traced pixel of the paper's estimate under the water model used
-    /// ([`crate::pipeline::FitSettings::paper_samples`]).
+    /// Lobe samples per traced pixel of the paper's estimate the fit started from, under the
+    /// water model used ([`crate::pipeline::FitSettings::paper_samples`],
+    /// [`crate::pipeline::FitSettings::quick_statistical_samples`]).
     pub samples: u32,
     /// Seed of every random number.
     pub seed: u64,

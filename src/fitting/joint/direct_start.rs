@@ -143,7 +143,7 @@ pub(super) fn overlap(a: &Rect, b: &Rect) -> f32 {
 /// (every pixel around it sees the wall: not cut by the frame, the water or anything in
 /// front): the rectangle of every image the start overlaps, and a pixel's footprint there.
 /// The light then ends within about a footprint of that rectangle's edges.
-pub(super) fn enclosing_image(
+pub(crate) fn enclosing_image(
     scene: &Scene,
     photo: &Photo,
     water: &[bool],

@@ -49,10 +49,13 @@ pub use uncertainty::{
 
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
+use super::joint::direct_start::enclosing_image;
 use super::joint::{
     fit_joint_with, place_starts, JointOptions, Lobe, ProposalCache, Reweight, Split, Uncertainty,
 };
-use super::{fit_paper_with, FitOptions, FittedLight, Rect, Skipped, StreakObservation};
+use super::{
+    fit_paper_with, FitOptions, FitOutcome, FittedLight, Rect, Skipped, StreakObservation,
+};
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::photo_in::Photo;
 use crate::pixel_scale::scaled_pixels;
@@ -124,13 +127,18 @@ pub struct SlopeEstimate {
     /// The start lights the final fit explained as two
     /// ([`super::joint::JointOutcome::splits`]).
     pub splits: Vec<Split>,
+    /// Lobe samples per traced pixel of the paper's estimate every fit started from.
+    pub start_samples: u32,
 }
 
 /// Estimates the slope variances over `surface` from the start `start_variance` (totals,
 /// along and across) and fits the lights with them (module doc). `paper` and `final_fit` as
 /// for [`super::gloss::estimate_gloss`] (their models' gloss is replaced by
 /// [`MICROFACET_GLOSS`]); `options` the one-dimensional search's settings, in the logarithm
-/// of a variance.
+/// of a variance. With `quick_samples`, the paper's estimate reads that many lobe samples a
+/// pixel first, and is kept when the direct view places every light it starts on a lamp's
+/// whole direct image (each such light is then pinned by its image whatever the start's
+/// noise); otherwise it is made again with `paper`'s samples.
 #[allow(clippy::too_many_arguments)]
 pub fn estimate_slopes(
     scene: &Scene,
@@ -140,6 +148,7 @@ pub fn estimate_slopes(
     surface: MeanSurface,
     start_variance: [f32; 2],
     paper: &FitOptions,
+    quick_samples: Option<u32>,
     final_fit: &JointOptions,
     options: &GlossSearch,
 ) -> Result<SlopeEstimate> {
@@ -157,14 +166,52 @@ pub fn estimate_slopes(
          search's start)",
         streaks.len()
     ));
-    let paper_fit = fit_paper_with(
-        &start_water,
-        scene,
-        photo,
-        water,
-        streaks,
-        &FitOptions { model, ..*paper },
-    )?;
+    let estimate = |samples: u32| {
+        fit_paper_with(
+            &start_water,
+            scene,
+            photo,
+            water,
+            streaks,
+            &FitOptions {
+                model,
+                samples,
+                ..*paper
+            },
+        )
+    };
+    // The start lights of `fit`: every fit starts alike, so the direct view places them once.
+    let placed = |fit: &FitOutcome| -> Result<Vec<FittedLight>> {
+        let start = search_start(fit, streaks.len(), "waves' slope")?;
+        Ok(if final_fit.direct_view {
+            place_starts(scene, photo, water, streaks, &start, final_fit.progress)
+        } else {
+            start
+        })
+    };
+    let quick = quick_samples.filter(|&q| q < paper.samples && final_fit.direct_view);
+    let mut start_samples = quick.unwrap_or(paper.samples);
+    let mut paper_fit = estimate(start_samples)?;
+    let mut placed_start = None;
+    if quick.is_some() {
+        // Out of frame the reflections alone place the lights, every fit of the search
+        // descends from the start, and a noisier start moves them (docs/decisions.md).
+        let start = (!paper_fit.lights.is_empty())
+            .then(|| placed(&paper_fit))
+            .transpose()?
+            .filter(|start| {
+                start
+                    .iter()
+                    .all(|light| enclosing_image(scene, photo, water, light).is_some())
+            });
+        match start {
+            Some(start) => placed_start = Some(start),
+            None => {
+                start_samples = paper.samples;
+                paper_fit = estimate(start_samples)?;
+            }
+        }
+    }
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
     if paper_fit.lights.is_empty() {
         // No light to estimate the slopes with: the caller reports the streaks skipped, as
@@ -184,17 +231,15 @@ pub fn estimate_slopes(
             cost: 0.0,
             correlation_area: 1.0,
             splits: Vec::new(),
+            start_samples,
         });
     }
-    let start = search_start(&paper_fit, streaks.len(), "waves' slope")?;
+    let start = match placed_start {
+        Some(start) => start,
+        None => placed(&paper_fit)?,
+    };
     let mut warnings = paper_fit.warnings.clone();
     let broad = water_with_total(surface, start_variance.map(|v| (4.0 * v).min(hi)));
-    // Every fit starts alike: the direct view places the starts once.
-    let start = if final_fit.direct_view {
-        place_starts(scene, photo, water, streaks, &start, final_fit.progress)
-    } else {
-        start
-    };
     let search_options = JointOptions {
         samples: options.search_samples,
         sweeps: options.search_sweeps,
@@ -419,6 +464,7 @@ pub fn estimate_slopes(
         cost: fit.cost,
         correlation_area: area,
         splits: fit.splits,
+        start_samples,
     })
 }
 
