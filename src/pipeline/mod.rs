@@ -36,7 +36,7 @@ use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::settings::Setting;
 use crate::streaks::{self, Segmentation};
-use crate::water_model::{ExactSurface, WaterModel};
+use crate::water_model::{ExactSurface, WaterModel, WaterStatistics};
 use crate::{water_mask, Error, Result};
 
 /// What a fit found.
@@ -197,6 +197,7 @@ pub fn fit(
         observations: &observations,
         statistical_samples: settings.paper_samples(true),
         quick_statistical_samples: settings.quick_statistical_samples(),
+        water_stats: std::cell::OnceCell::new(),
         paper: FitOptions {
             samples: settings.paper_samples(false),
             seed: settings.seed,
@@ -319,6 +320,8 @@ struct Run<'a> {
     /// The samples of the statistical start's first try
     /// ([`FitSettings::quick_statistical_samples`]).
     quick_statistical_samples: Option<u32>,
+    /// What the camera sees of the scene's water, once asked for.
+    water_stats: std::cell::OnceCell<Option<WaterStatistics>>,
     progress: Reporter<'a>,
 }
 

@@ -13,7 +13,7 @@ use crate::fitting::slopes::{estimate_slopes, water_with_total, MICROFACET_GLOSS
 use crate::fitting::{self, FitOptions};
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::settings::Setting;
-use crate::water_model::water_statistics;
+use crate::water_model::{water_statistics, WaterStatistics};
 use crate::{Error, Result};
 
 impl WaterModelUsed {
@@ -142,8 +142,15 @@ impl Run<'_> {
 
     /// Why the scene's water is flat (module doc of `water_choice`), or `None` when it holds
     /// waves (or the camera sees none of it: the fit then says so).
+    /// What the camera sees of the scene's water ([`water_statistics`]), measured once.
+    fn water_statistics(&self) -> Option<WaterStatistics> {
+        *self
+            .water_stats
+            .get_or_init(|| water_statistics(self.scene, self.photo.width, self.photo.height))
+    }
+
     fn flat_water(&self) -> Option<String> {
-        let stats = water_statistics(self.scene, self.photo.width, self.photo.height)?;
+        let stats = self.water_statistics()?;
         let gloss = self.paper.model.gloss;
         let micro = GaussianSlopes::from_gloss(gloss).variance;
         let mesh = stats.slope_variance;
@@ -188,13 +195,12 @@ impl Run<'_> {
         chosen: &'static str,
         correlation: Option<f64>,
     ) -> Result<WaterModelUsed> {
-        let stats =
-            water_statistics(self.scene, self.photo.width, self.photo.height).ok_or_else(|| {
-                Error::scene(
-                    &self.scene.path,
-                    format!("the camera sees no water: check {}", Setting::Water),
-                )
-            })?;
+        let stats = self.water_statistics().ok_or_else(|| {
+            Error::scene(
+                &self.scene.path,
+                format!("the camera sees no water: check {}", Setting::Water),
+            )
+        })?;
         let gloss = self.paper.model.gloss;
         let micro = GaussianSlopes::from_gloss(gloss).variance;
         let mesh = stats.slope_variance;

@@ -15,6 +15,7 @@
 //! water, which fills most of the image, counts most).
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 use crate::render::{camera_hit, CameraHit};
 use crate::scene_in::Scene;
@@ -100,23 +101,24 @@ pub const GRID: u32 = 256;
 /// The statistics of the water the camera sees, over a `GRID` x `GRID` grid of camera rays
 /// of a `width` x `height` image (see the module doc); `None` when no ray meets the water.
 pub fn water_statistics(scene: &Scene, width: u32, height: u32) -> Option<WaterStatistics> {
-    let mut points = Vec::new();
-    let mut normals = Vec::new();
-    for j in 0..GRID {
-        for i in 0..GRID {
+    // The grid's rays in parallel, kept in the grid's order (the sums below run in it).
+    let (points, normals): (Vec<DVec3>, Vec<DVec3>) = (0..GRID * GRID)
+        .into_par_iter()
+        .filter_map(|k| {
+            let (i, j) = (k % GRID, k / GRID);
             let x = (i as f32 + 0.5) / GRID as f32 * width as f32;
             let y = (j as f32 + 0.5) / GRID as f32 * height as f32;
-            if let CameraHit::Water(w) = camera_hit(scene, &[], x, y, width, height) {
-                points.push(w.start.as_dvec3());
-                let n = if w.normal.dot(w.face) < 0.0 {
-                    -w.normal
-                } else {
-                    w.normal
-                };
-                normals.push(n.as_dvec3());
-            }
-        }
-    }
+            let CameraHit::Water(w) = camera_hit(scene, &[], x, y, width, height) else {
+                return None;
+            };
+            let n = if w.normal.dot(w.face) < 0.0 {
+                -w.normal
+            } else {
+                w.normal
+            };
+            Some((w.start.as_dvec3(), n.as_dvec3()))
+        })
+        .unzip();
     if points.is_empty() {
         return None;
     }
@@ -139,12 +141,12 @@ pub fn water_statistics(scene: &Scene, width: u32, height: u32) -> Option<WaterS
     );
     surface.crest = scene
         .triangles
-        .iter()
+        .par_iter()
         .zip(&scene.is_water)
         .filter(|(_, &w)| w)
-        .flat_map(|(t, _)| t.iter())
+        .flat_map_iter(|(t, _)| t.iter())
         .map(|&p| (p - surface.point).dot(surface.normal))
-        .fold(0.0f32, f32::max);
+        .reduce(|| 0.0f32, f32::max);
     let slopes: Vec<[f64; 2]> = normals
         .iter()
         .map(|n| surface.slopes(n.as_vec3()).map(|s| s as f64))
@@ -172,23 +174,23 @@ fn area_weighted_plane(
     up: DVec3,
 ) -> Option<(DVec3, DVec3)> {
     let (w, h) = (width as f32, height as f32);
+    // The triangles centred in view, found in parallel; summed below in their order.
+    let framed: Vec<u32> = (0..scene.triangles.len() as u32)
+        .into_par_iter()
+        .filter(|&i| {
+            let t = &scene.triangles[i as usize];
+            scene.is_water[i as usize]
+                && scene
+                    .camera
+                    .project((t[0] + t[1] + t[2]) / 3.0, width, height)
+                    .is_some_and(|(x, y)| (0.0..w).contains(&x) && (0.0..h).contains(&y))
+        })
+        .collect();
     let mut area_vector = DVec3::ZERO;
     let mut moment = DVec3::ZERO;
     let mut area = 0.0f64;
-    for (t, _) in scene
-        .triangles
-        .iter()
-        .zip(&scene.is_water)
-        .filter(|(_, &water)| water)
-    {
-        let c = (t[0] + t[1] + t[2]) / 3.0;
-        let Some((x, y)) = scene.camera.project(c, width, height) else {
-            continue;
-        };
-        if !(0.0..w).contains(&x) || !(0.0..h).contains(&y) {
-            continue;
-        }
-        let [a, b, d] = t.map(|p| p.as_dvec3());
+    for &i in &framed {
+        let [a, b, d] = scene.triangles[i as usize].map(|p| p.as_dvec3());
         let mut v = 0.5 * (b - a).cross(d - a);
         // Every triangle's area vector up, whatever its winding (not towards the camera: a
         // wave face turned away from a grazing camera would be flipped).

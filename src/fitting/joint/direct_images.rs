@@ -9,6 +9,7 @@
 use std::collections::VecDeque;
 
 use glam::Vec2;
+use rayon::prelude::*;
 
 use super::direct::image_box;
 use crate::fitting::light_plane::LightPlane;
@@ -56,34 +57,35 @@ pub(super) fn images_in(
         return Vec::new();
     };
     // The pixels of the box that see the plane inside the search rectangle: index, plane
-    // coordinates, distance from the camera, brightness.
-    let mut seen: Vec<(usize, Vec2, f32, f32)> = Vec::new();
+    // coordinates, distance from the camera, brightness; traced row by row in parallel,
+    // kept in the box's order.
     let origin = scene.camera.position;
-    for y in y0..=y1 {
-        for x in x0..=x1 {
-            let i = photo.index(x, y);
-            if water[i] {
-                continue;
-            }
-            let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
-            let Some(hit) = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY) else {
-                continue;
-            };
-            if !plane.contains_triangle(scene, hit.triangle) {
-                continue;
-            }
-            let q = plane.coords(origin + dir * hit.t);
-            if !search.contains(q) {
-                continue;
-            }
-            let value = if photo.clipped[i] {
-                f32::INFINITY
-            } else {
-                photo.radiance[i].into_iter().fold(0.0f32, f32::max)
-            };
-            seen.push((i, q, hit.t, value));
-        }
-    }
+    let seen: Vec<(usize, Vec2, f32, f32)> = (y0..=y1)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (x0..=x1).filter_map(move |x| {
+                let i = photo.index(x, y);
+                if water[i] {
+                    return None;
+                }
+                let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
+                let hit = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY)?;
+                if !plane.contains_triangle(scene, hit.triangle) {
+                    return None;
+                }
+                let q = plane.coords(origin + dir * hit.t);
+                if !search.contains(q) {
+                    return None;
+                }
+                let value = if photo.clipped[i] {
+                    f32::INFINITY
+                } else {
+                    photo.radiance[i].into_iter().fold(0.0f32, f32::max)
+                };
+                Some((i, q, hit.t, value))
+            })
+        })
+        .collect();
     let brightest = seen
         .iter()
         .map(|s| s.3)

@@ -204,6 +204,8 @@ pub fn fit_joint_with(
     if start.is_empty() {
         return Ok(JointOutcome::empty());
     }
+    // The footprints' stage counts from here: placing the starts traces the lamps' images.
+    let t0 = Instant::now();
     // Starts far from the lights' direct images are moved onto them, one light per lamp
     // (`place_starts`).
     let moved;
@@ -226,7 +228,6 @@ pub fn fit_joint_with(
             s.id, photo.width, photo.height
         )));
     }
-    let t0 = Instant::now();
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
     // A light on a lamp's whole direct image searches close around it where asked
     // (`region_of_interest`, `JointOptions::close_regions`).
