@@ -34,6 +34,11 @@ pub(super) fn first_window(r: &Rect, distance: f32) -> f32 {
     (0.5 * r.width().max(r.height())).max(FIRST_WINDOW_SHARE * distance)
 }
 
+/// The first half-window of an edge a light's direct image pins, in units of the one-sigma
+/// bound the image sets on it (`footprint / sqrt(3)`, [`Problem::image_bounds`]): two pixel
+/// footprints.
+const IMAGE_FIRST_WINDOW: f32 = 2.0 * 1.732_050_8;
+
 /// The least first window, as a share of the light's distance from the camera: 0.5 m at the
 /// harbour's 40 m (at the paper's 10 m, 12.5 cm: no light of its samples is that small).
 const FIRST_WINDOW_SHARE: f32 = 0.0125;
@@ -48,12 +53,24 @@ impl Problem {
     /// Coordinate descent over every free edge (see the module doc) for at most `sweeps`
     /// sweeps, stopping early once every search window has shrunk to its minimum.
     pub(super) fn descend(&self, st: &mut State, extents: &[Option<Rect>], sweeps: u32) {
-        // Initial half-windows: see `first_window`.
+        // Initial half-windows: see `first_window`; a few pixel footprints for a light its
+        // direct image pins on every side (`image_bounds`), which lies within about one of
+        // its optimum already.
+        let bounds = self.image_bounds(st);
         let mut windows: Vec<[f32; 4]> = st
             .rects
             .iter()
             .zip(&st.set_of)
-            .map(|(r, &set)| [first_window(r, self.planes[set].distance); 4])
+            .zip(&bounds)
+            .map(|((r, &set), bound)| {
+                let wide = first_window(r, self.planes[set].distance);
+                match bound {
+                    [Some(l), Some(rt), Some(b), Some(t)] => {
+                        [*l, *rt, *b, *t].map(|s| (IMAGE_FIRST_WINDOW * s).min(wide))
+                    }
+                    _ => [wide; 4],
+                }
+            })
             .collect();
         let min_windows: Vec<f32> = st.rects.iter().map(min_window).collect();
         let grid = GRID;
