@@ -77,8 +77,10 @@ pub const DEFAULT_SAMPLES: u32 = 512;
 /// Default lobe samples per traced pixel of the paper's estimate where it is the start of the
 /// exact model's joint fit: the joint fit's descent moves every edge from there, and its
 /// first search window spans half the light's size. On the samples the lights came out
-/// within 0.1 % of those from 512 samples (a tenth of a sigma), in a quarter of the
-/// estimate's time (docs/decisions.md).
+/// within 0.1 % of those from 512 samples (at most 0.6 of a sigma apart), in a quarter of
+/// the estimate's time (docs/decisions.md). The statistical model's start tries it first too,
+/// and keeps it where every light it starts is pinned by its lamp's image
+/// ([`crate::pipeline::FitSettings::quick_statistical_samples`]).
 pub const DEFAULT_START_SAMPLES: u32 = 128;
 
 /// An edge of the light's rectangle (of the light, not of the streak).

@@ -16,8 +16,8 @@ use crate::{Error, Result};
 pub struct FitSettings {
     /// Lobe samples per traced pixel of the paper's estimate (method §5 steps 7-9); `None`:
     /// [`DEFAULT_SAMPLES`], or [`DEFAULT_START_SAMPLES`] where the estimate starts the exact
-    /// model's joint fit ([`Self::paper_samples`]). The edge
-    /// solutions average over tens of pixels, so a few hundred suffice.
+    /// model's joint fit ([`Self::paper_samples`], [`Self::quick_statistical_samples`]). The
+    /// edge solutions average over tens of pixels, so a few hundred suffice.
     pub samples: Option<u32>,
     /// Seed of every random number of the fit: the same inputs and seed give the same lights.
     pub seed: u64,
@@ -36,9 +36,9 @@ pub struct FitSettings {
 }
 
 impl Default for FitSettings {
-    /// The defaults of `streaklight fit`: the paper's estimate's samples by its use, seed 1, the paper's
-    /// G = 1, the default streak extraction, the joint method with the scene's gloss, the
-    /// water model chosen from the photo, the night's background taken off.
+    /// The defaults of `streaklight fit`: the paper's estimate's samples by its use, seed 1,
+    /// the paper's G = 1, the default streak extraction, the joint method with the scene's
+    /// gloss, the water model chosen from the photo, the night's background taken off.
     fn default() -> Self {
         FitSettings {
             samples: None,
@@ -262,8 +262,8 @@ mod tests {
     }
 
     /// The paper's estimate reads 128 samples where it only starts the exact model's joint
-    /// fit, 512 where it is the result or the statistical model's start, and what was asked
-    /// for wherever it was asked.
+    /// fit, 512 where it is the result or the statistical model's start (which tries 128
+    /// first), and what was asked for wherever it was asked.
     #[test]
     fn the_paper_estimates_samples_follow_its_use() {
         let joint = FitSettings::default();
