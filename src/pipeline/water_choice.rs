@@ -132,7 +132,9 @@ pub struct SlopesUsed {
     /// Pixels per independent residual of the final fit (the glitter's correlation area):
     /// every uncertainty was grown by its square root; `None` for the paper's method.
     pub correlation_area: Option<f64>,
-    /// Lobe samples per traced pixel of the paper's estimate the fit started from.
+    /// Lobe samples per traced pixel of the paper's estimate the fit started from (reported
+    /// as the settings' `samples`, not here).
+    #[serde(skip)]
     pub start_samples: u32,
 }
 
