@@ -249,8 +249,8 @@ fn joint_fits_table3() {
         );
     }
     assert!(r1 < 0.018, "light1 radiance off by {:.3} %", 100.0 * r1);
-    // Uncertainties: both lights' errors within 5 sigma. Over 8 seeds the largest is 2.1
-    // sigma for light0 and 1.6 for light1 (`cargo bench --bench spread`, BENCHMARKS.md).
+    // Uncertainties: both lights' errors within 5 sigma. Over 8 seeds the largest is 1.8
+    // sigma for light0 and 1.9 for light1 (`cargo bench --bench spread`, BENCHMARKS.md).
     let (s0, sr0) = sigmas(&joint[0], &truths[0]);
     let (s1, sr1) = sigmas(&joint[1], &truths[1]);
     eprintln!("table3: light0 errors in sigmas {s0:?} {sr0:.2}; light1 {s1:?} {sr1:.2}");
