@@ -58,6 +58,15 @@ pub struct Tracer {
     ordered: Vec<Triangle>,
     /// For each entry of `ordered`, its index in the caller's list.
     original_index: Vec<u32>,
+    /// This tracer's own number, unique in the process ([`Tracer::id`]).
+    id: u64,
+}
+
+/// The number the next tracer built takes.
+static NEXT_TRACER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+fn next_id() -> u64 {
+    NEXT_TRACER.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Per-ray constants of the watertight test: the axis permutation and the shear.
@@ -189,6 +198,7 @@ impl Tracer {
                 bvh: None,
                 ordered: Vec::new(),
                 original_index: Vec::new(),
+                id: next_id(),
             };
         }
         // The cheapest preset: on the sample scene (518k triangles, mostly the water's
@@ -208,6 +218,7 @@ impl Tracer {
             bvh: Some(bvh),
             ordered,
             original_index,
+            id: next_id(),
         }
     }
 
@@ -219,6 +230,12 @@ impl Tracer {
     /// True when there is nothing to hit.
     pub fn is_empty(&self) -> bool {
         self.ordered.is_empty()
+    }
+
+    /// A number no other tracer of this process has: what is cached from its hits is kept
+    /// under it, so a rebuilt tracer never reads a cache of the old one.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// The closest hit along `origin + t dir` with `tmin < t < tmax`; `dir` must be unit length.

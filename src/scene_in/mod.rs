@@ -5,6 +5,7 @@
 
 mod area_lights;
 mod camera;
+mod centre_hits;
 pub mod document;
 mod meshes;
 mod nodes;
@@ -17,6 +18,7 @@ use glam::{DVec3, Vec3};
 
 pub use area_lights::AreaLight;
 pub use camera::Camera;
+pub use centre_hits::{BoxHits, PixelBox};
 pub use meshes::{is_fallback_quad, TriangleSource};
 pub use nodes::{world_instances, NodeInstance};
 pub use water::{gloss_from_roughness, roughness_from_gloss, Water, DEFAULT_GLOSS, WATER_IOR};
@@ -86,6 +88,8 @@ pub struct Scene {
     /// The BVH over every triangle but the water's, built on first use
     /// ([`Scene::closest_hit_above_water`]).
     above_water: OnceLock<AboveWater>,
+    /// The camera's centre rays traced so far ([`Scene::centre_hits`]).
+    centre_hit_cache: centre_hits::CentreHitCache,
 }
 
 /// A BVH over the triangles that are not water, and each one's index in [`Scene::triangles`].
@@ -319,6 +323,7 @@ pub fn load_from_bytes(
         warnings,
         node_names,
         above_water: OnceLock::new(),
+        centre_hit_cache: Default::default(),
     })
 }
 

@@ -56,42 +56,48 @@ pub(super) fn images_in(
     let Some((x0, y0, x1, y1)) = image_box(scene, &[plane], &[search], w, h) else {
         return Vec::new();
     };
-    // The pixels of the box that see the plane inside the search rectangle: index, plane
-    // coordinates, distance from the camera, brightness; traced row by row in parallel,
-    // kept in the box's order.
+    // Per pixel of the box, row-major: its brightness where it sees the plane inside the
+    // search rectangle, else NaN. Traced row by row in parallel, the camera rays' hits from
+    // the scene's cache of them (`Scene::centre_hits`).
     let origin = scene.camera.position;
-    let seen: Vec<(usize, Vec2, f32, f32)> = (y0..=y1)
+    let hits = scene.centre_hits((x0, y0, x1, y1), w, h, &|i| water[i]);
+    let hits = &hits;
+    let (bw, bh) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
+    // Where pixel (x, y) sees the plane, if it does inside the search rectangle: plane
+    // coordinates and distance from the camera.
+    let on_plane = |x: u32, y: u32| -> Option<(Vec2, f32)> {
+        if water[photo.index(x, y)] {
+            return None;
+        }
+        let (triangle, t) = hits.get(x, y)?;
+        if !plane.contains_triangle(scene, triangle) {
+            return None;
+        }
+        let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
+        let q = plane.coords(origin + dir * t);
+        search.contains(q).then_some((q, t))
+    };
+    let value: Vec<f32> = (y0..=y1)
         .into_par_iter()
         .flat_map_iter(|y| {
-            (x0..=x1).filter_map(move |x| {
-                let i = photo.index(x, y);
-                if water[i] {
-                    return None;
+            (x0..=x1).map(move |x| match on_plane(x, y) {
+                None => f32::NAN,
+                Some(_) => {
+                    let i = photo.index(x, y);
+                    if photo.clipped[i] {
+                        f32::INFINITY
+                    } else {
+                        photo.radiance[i].into_iter().fold(0.0f32, f32::max)
+                    }
                 }
-                let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
-                let hit = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY)?;
-                if !plane.contains_triangle(scene, hit.triangle) {
-                    return None;
-                }
-                let q = plane.coords(origin + dir * hit.t);
-                if !search.contains(q) {
-                    return None;
-                }
-                let value = if photo.clipped[i] {
-                    f32::INFINITY
-                } else {
-                    photo.radiance[i].into_iter().fold(0.0f32, f32::max)
-                };
-                Some((i, q, hit.t, value))
             })
         })
         .collect();
-    let brightest = seen
+    let brightest = value
         .iter()
-        .map(|s| s.3)
         .filter(|v| v.is_finite())
-        .fold(0.0f32, f32::max);
-    let any_clipped = seen.iter().any(|s| s.3.is_infinite());
+        .fold(0.0f32, |a, &v| a.max(v));
+    let any_clipped = value.iter().any(|v| v.is_infinite());
     if brightest <= 0.0 && !any_clipped {
         return Vec::new();
     }
@@ -100,21 +106,35 @@ pub(super) fn images_in(
     } else {
         0.5 * brightest
     };
-    let bright: Vec<&(usize, Vec2, f32, f32)> = seen.iter().filter(|s| s.3 >= threshold).collect();
-    let groups = groups_8(&bright.iter().map(|s| s.0).collect::<Vec<_>>(), w as usize);
-    let sees_plane: std::collections::HashSet<usize> = seen.iter().map(|s| s.0).collect();
+    // The bright pixels, in the box's order: box index, image index, plane coordinates,
+    // distance.
+    let bright: Vec<(usize, usize, Vec2, f32)> = value
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v >= threshold)
+        .filter_map(|(b, _)| {
+            let (x, y) = (x0 + (b % bw) as u32, y0 + (b / bw) as u32);
+            on_plane(x, y).map(|(q, t)| (b, photo.index(x, y), q, t))
+        })
+        .collect();
+    let groups = groups_8(&bright.iter().map(|s| s.0).collect::<Vec<_>>(), bw, bh);
     // Whether every 8-neighbour of group pixel m is in the frame and sees the plane.
     let surrounded = |m: usize| {
-        let p = bright[m].0;
-        let (x, y) = ((p % w as usize) as i64, (p / w as usize) as i64);
+        let b = bright[m].0;
+        let (x, y) = ((b % bw) as i64, (b / bw) as i64);
+        let (gx, gy) = (x + x0 as i64, y + y0 as i64);
         (-1..=1i64).all(|dy| {
             (-1..=1i64).all(|dx| {
                 let (nx, ny) = (x + dx, y + dy);
-                nx >= 0
+                gx + dx >= 0
+                    && gy + dy >= 0
+                    && gx + dx < w as i64
+                    && gy + dy < h as i64
+                    && nx >= 0
                     && ny >= 0
-                    && nx < w as i64
-                    && ny < h as i64
-                    && sees_plane.contains(&(ny as usize * w as usize + nx as usize))
+                    && (nx as usize) < bw
+                    && (ny as usize) < bh
+                    && !value[ny as usize * bw + nx as usize].is_nan()
             })
         })
     };
@@ -132,7 +152,7 @@ pub(super) fn images_in(
             };
             let mut t_sum = 0.0;
             for &m in &g {
-                let (_, q, t, _) = bright[m];
+                let (_, _, q, t) = bright[m];
                 rect.u_min = rect.u_min.min(q.x);
                 rect.u_max = rect.u_max.max(q.x);
                 rect.v_min = rect.v_min.min(q.y);
@@ -147,7 +167,7 @@ pub(super) fn images_in(
             let open: Vec<bool> = g.iter().map(|&m| !surrounded(m)).collect();
             let mut along = [(0usize, 0usize); 4];
             for (&m, &open) in g.iter().zip(&open) {
-                let q = bright[m].1;
+                let q = bright[m].2;
                 let gaps = [
                     q.x - rect.u_min,
                     rect.u_max - q.x,
@@ -163,7 +183,7 @@ pub(super) fn images_in(
             }
             let cut = along.map(|(all, open)| 2 * open > all);
             DirectImage {
-                first_pixel: g.iter().map(|&m| bright[m].0).min().unwrap_or(0),
+                first_pixel: g.iter().map(|&m| bright[m].1).min().unwrap_or(0),
                 rect: rect.grow(half_pixel),
                 enclosed: !open.contains(&true),
                 cut,
@@ -174,11 +194,14 @@ pub(super) fn images_in(
         .collect()
 }
 
-/// The 8-connected groups of the image pixels `pixels` (indices into a row-major image of
-/// width `width`), each a list of positions in `pixels`.
-fn groups_8(pixels: &[usize], width: usize) -> Vec<Vec<usize>> {
-    let position: std::collections::HashMap<usize, usize> =
-        pixels.iter().enumerate().map(|(k, &p)| (p, k)).collect();
+/// The 8-connected groups of the pixels `pixels` (indices into a row-major box of `width` x
+/// `height` pixels), each a list of positions in `pixels`.
+fn groups_8(pixels: &[usize], width: usize, height: usize) -> Vec<Vec<usize>> {
+    const ABSENT: u32 = u32::MAX;
+    let mut position = vec![ABSENT; width * height];
+    for (k, &p) in pixels.iter().enumerate() {
+        position[p] = k as u32;
+    }
     let mut group_of = vec![usize::MAX; pixels.len()];
     let mut groups = Vec::new();
     for k in 0..pixels.len() {
@@ -195,15 +218,18 @@ fn groups_8(pixels: &[usize], width: usize) -> Vec<Vec<usize>> {
             for dy in -1..=1i64 {
                 for dx in -1..=1i64 {
                     let (nx, ny) = (x + dx, y + dy);
-                    if (dx, dy) == (0, 0) || nx < 0 || ny < 0 || nx >= width as i64 {
+                    if (dx, dy) == (0, 0)
+                        || nx < 0
+                        || ny < 0
+                        || nx >= width as i64
+                        || ny >= height as i64
+                    {
                         continue;
                     }
-                    let p = ny as usize * width + nx as usize;
-                    if let Some(&n) = position.get(&p) {
-                        if group_of[n] == usize::MAX {
-                            group_of[n] = id;
-                            queue.push_back(n);
-                        }
+                    let n = position[ny as usize * width + nx as usize];
+                    if n != ABSENT && group_of[n as usize] == usize::MAX {
+                        group_of[n as usize] = id;
+                        queue.push_back(n as usize);
                     }
                 }
             }
@@ -221,7 +247,7 @@ mod tests {
     fn groups_are_8_connected() {
         // Width 5: (0,0),(1,1) touch diagonally; (4,0) is alone; (3,3),(4,3) touch.
         let px = [0, 6, 4, 18, 19];
-        let mut g = groups_8(&px, 5);
+        let mut g = groups_8(&px, 5, 4);
         g.iter_mut().for_each(|m| m.sort_unstable());
         g.sort();
         assert_eq!(g, vec![vec![0, 1], vec![2], vec![3, 4]]);
