@@ -207,6 +207,12 @@ fn a_start_moved_onto_a_cut_image_keeps_its_extent_beyond_the_cut() {
 fn joint_fits_table3() {
     let truths = samples::table3_lights();
     let report = fit_report("table3.png", Method::default(), 1);
+    // Light1's lamp is cut by the frame: its reflections must place its edges, and the fit
+    // reads the checkerboard.
+    assert_eq!(
+        report.settings.joint_pixels.as_deref(),
+        Some("checkerboard")
+    );
     // Two streaks, one light each: nothing to warn about overlapping reflections.
     assert!(
         report.warnings.iter().all(|w| !w.contains("overlap")),
@@ -466,9 +472,11 @@ fn joint_method_through_the_converter() {
         outcome.report.settings.joint_samples,
         Some(streaklight::fitting::joint::DEFAULT_JOINT_SAMPLES)
     );
+    // The lamp's whole image is in the photo and pins every edge: the water pixels, which
+    // give the radiance, are read one of each 2 x 2 block.
     assert_eq!(
         outcome.report.settings.joint_pixels.as_deref(),
-        Some("checkerboard")
+        Some("one water pixel of each 2 x 2 block")
     );
     assert_eq!(outcome.report.lights.len(), 1);
     let light = &outcome.report.lights[0];

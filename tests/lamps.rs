@@ -54,7 +54,8 @@ fn an_orange_lamp_under_a_blue_one_gives_two_lights() {
 
 /// The stacked sample (two white lamps 0.8 m apart, one streak), both lamps in the photo: at
 /// the defaults each light is pinned by its own lamp's image, so no refit over every pixel
-/// and no warning of lights told apart only weakly. Held: every edge and the radiance within
+/// (the fit reads one water pixel of each 2 x 2 block, as where every lamp's image pins its
+/// light) and no warning of lights told apart only weakly. Held: every edge and the radiance within
 /// 1 % (measured: 0.15 % and 0.3 %; from the reflections alone, `tests/joint.rs`, the facing
 /// edges are about 5 % rms off and the upper light's radiance up to 14 %).
 #[test]
@@ -63,7 +64,7 @@ fn stacked_lamps_in_the_photo_are_two_lights_from_the_start() {
     assert_eq!(report.lights.len(), 2, "{:?}", report.warnings);
     assert_eq!(
         report.settings.joint_pixels.as_deref(),
-        Some("checkerboard")
+        Some("one water pixel of each 2 x 2 block")
     );
     assert!(
         report

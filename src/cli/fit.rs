@@ -130,9 +130,11 @@ pub struct Args {
     pub joint_samples: Option<u32>,
     /// Fit every water pixel near the streaks instead of every second one (a checkerboard;
     /// one of each 2 x 2 block on a photo of more than a megapixel, of each 4 x 4 block at
-    /// 4000 x 3000): about twice the joint fit's time (four times or more), and less of both
-    /// the samples' and the photo's noise (more samples per pixel cannot average the photo's
-    /// noise). Lights sharing a streak get this by default (see --joint-samples).
+    /// 4000 x 3000, and of each 2 x 2 block where the photo shows every light whole above
+    /// the water and its streaks are large): about twice the joint fit's time (four times or
+    /// more), and less of both the samples' and the photo's noise (more samples per pixel
+    /// cannot average the photo's noise). Lights sharing a streak get this by default (see
+    /// --joint-samples).
     #[arg(long)]
     pub all_pixels: bool,
     /// Fit the water pixels alone: without this, the joint fit also reads the pixels that

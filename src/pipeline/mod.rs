@@ -223,6 +223,7 @@ pub fn fit(
         modelled: Vec::new(),
         splits: Vec::new(),
         stopped_at_start: false,
+        share: None,
     };
     let water_model = if observations.is_empty() {
         match settings.water {
@@ -262,7 +263,9 @@ pub fn fit(
         gloss: found.gloss.0,
         gloss_source: found.gloss.1,
         reading: found.reading,
-        pixel_share: found.reading.map(|r| r.share(photo.len() as u64)),
+        pixel_share: found
+            .share
+            .or_else(|| found.reading.map(|r| r.share(photo.len() as u64))),
         water_model,
         water,
         segmentation,
@@ -289,6 +292,8 @@ struct Found {
     /// Whether the last joint fit ended at its start (its start gate said so): no light,
     /// and `modelled` is the start lights' expected image.
     stopped_at_start: bool,
+    /// Which pixels the last joint fit read (`None`: as its reading gives them).
+    share: Option<PixelShare>,
 }
 
 impl Found {
@@ -354,6 +359,7 @@ impl Run<'_> {
             samples: reading.samples,
             pixels: reading.share(self.photo.len() as u64),
             direct_view: j.direct_view,
+            thin_seen_whole: true,
             ..JointOptions::new(self.paper.model, self.paper.seed)
         }
     }
@@ -387,6 +393,7 @@ impl Run<'_> {
         found.uncertainties = outcome.uncertainty;
         found.modelled = outcome.modelled;
         found.splits = outcome.splits;
+        found.share = Some(outcome.share);
         found.stopped_at_start = outcome.stopped_at_start;
         found.warnings.extend(outcome.warnings);
         Ok(())
@@ -498,6 +505,7 @@ impl Run<'_> {
         found.warnings.extend(estimate.warnings);
         found.timings = estimate.timings;
         found.modelled = estimate.modelled;
+        found.share = Some(estimate.share);
         found.splits = estimate.splits;
         let at_estimate = JointOptions {
             model: ReflectionModel {

@@ -248,6 +248,8 @@ pub struct GlossEstimate {
     /// The final joint fit's expected image: its fitted water pixels with their modelled
     /// radiance ([`super::joint::JointOutcome::modelled`]).
     pub modelled: Vec<ModelledPixel>,
+    /// Which pixels the final fit read ([`JointOutcome::share`](super::joint::JointOutcome::share)).
+    pub share: PixelShare,
     /// The start lights the final fit explained as two
     /// ([`super::joint::JointOutcome::splits`]).
     pub splits: Vec<Split>,
@@ -365,6 +367,7 @@ pub fn estimate_gloss(
             warnings,
             timings,
             modelled,
+            share: options.search_pixels,
             splits: Vec::new(),
             stopped_at_start: true,
         });
@@ -432,6 +435,7 @@ pub fn estimate_gloss(
         warnings,
         timings,
         modelled: final_fit.modelled,
+        share: final_fit.share,
         splits: final_fit.splits,
         stopped_at_start: false,
     })

@@ -135,7 +135,7 @@ mod uncertainty;
 
 pub use options::{
     JointOptions, ModelledPixel, PixelShare, StartGate, DEFAULT_JOINT_SAMPLES, LARGE_PHOTO_PIXELS,
-    MAX_JOINT_SAMPLES,
+    MAX_JOINT_SAMPLES, THIN_MIN_WATER_PIXELS,
 };
 pub use outcome::JointOutcome;
 pub use proposal::{Lobe, ProposalCache, Reweight, TARGET_OVER_PROPOSAL};
@@ -231,15 +231,20 @@ pub fn fit_joint_with(
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
     // A light on a lamp's whole direct image searches close around it where asked
     // (`region_of_interest`, `JointOptions::close_regions`).
-    let roi: Vec<Rect> = start
+    let images: Vec<Option<(Rect, f32)>> = start
         .iter()
         .map(|light| {
-            let image = (options.direct_view && options.close_regions)
+            (options.direct_view && (options.close_regions || options.thin_seen_whole))
                 .then(|| enclosing_image(scene, photo, water, light))
-                .flatten();
-            region_of_interest(light, image)
+                .flatten()
         })
         .collect();
+    let roi: Vec<Rect> = start
+        .iter()
+        .zip(&images)
+        .map(|(light, &image)| region_of_interest(light, image.filter(|_| options.close_regions)))
+        .collect();
+
     let probe_model = ReflectionModel {
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model
@@ -256,6 +261,21 @@ pub fn fit_joint_with(
         options.margin,
         options.pixels,
     );
+    // Where every lamp pins its light and the water is plenty, one water pixel of each 2 x 2
+    // block (`JointOptions::thin_seen_whole`): those of the checkerboard's in even rows.
+    let mut share = options.pixels;
+    let thinned = options.share_for(images.iter().all(Option::is_some));
+    if thinned != share {
+        let kept: Vec<u32> = pixels
+            .iter()
+            .copied()
+            .filter(|&p| thinned.reads(p % photo.width, p / photo.width))
+            .collect();
+        if kept.len() >= THIN_MIN_WATER_PIXELS {
+            pixels = kept;
+            share = thinned;
+        }
+    }
     // The pixels that see the lights' walls directly follow the water pixels.
     let first_direct = pixels.len();
     if options.direct_view {
@@ -266,7 +286,7 @@ pub fn fit_joint_with(
             photo.width,
             photo.height,
             water,
-            options.pixels,
+            share,
         ));
     }
     let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
@@ -340,6 +360,7 @@ pub fn fit_joint_with(
         if !(gate.0)(&modelled) {
             return Ok(JointOutcome {
                 pixels: pixels.len(),
+                share,
                 timings: vec![("footprints".into(), footprint_seconds)],
                 modelled,
                 stopped_at_start: true,
@@ -549,6 +570,7 @@ pub fn fit_joint_with(
         lights,
         uncertainty,
         pixels: pixels.len(),
+        share,
         residual_variance: variance,
         cost,
         timings: vec![

@@ -99,6 +99,15 @@ pub struct JointOptions<'a> {
     /// ([`place_starts`](super::place_starts)): the fit takes them as they are. A search
     /// whose fits all start from the same lights places them once. Off by default.
     pub starts_placed: bool,
+    /// Where every start light lies on a lamp's whole direct image, read one water pixel of
+    /// each 2 x 2 block instead of the [`PixelShare::Checkerboard`] (the pixels that see a
+    /// light directly stay a checkerboard), if that still reads at least
+    /// [`THIN_MIN_WATER_PIXELS`] water pixels: the images pin every edge, and the water
+    /// pixels are left the radiances, which half of a large streak's give as well to a few
+    /// hundredths of a percent, in about two thirds of the time (docs/decisions.md). Only a
+    /// checkerboard is thinned. Off by default; a fit whose cost is compared with others' (a
+    /// search) leaves it off.
+    pub thin_seen_whole: bool,
 }
 
 /// A test of a joint fit's start image ([`JointOptions::start_gate`]): the water pixels'
@@ -141,6 +150,17 @@ impl JointOptions<'_> {
             start_gate: None,
             held: &[],
             starts_placed: false,
+            thin_seen_whole: false,
+        }
+    }
+
+    /// The pixels a fit reads ([`Self::pixels`], thinned by [`Self::thin_seen_whole`] when
+    /// every start light is `seen_whole`).
+    pub fn share_for(&self, seen_whole: bool) -> PixelShare {
+        if self.thin_seen_whole && seen_whole && self.pixels == PixelShare::Checkerboard {
+            PixelShare::WaterBlocks(2)
+        } else {
+            self.pixels
         }
     }
 }
@@ -237,6 +257,13 @@ impl PixelShare {
         }
     }
 }
+
+/// The fewest water pixels a fit thinned by [`JointOptions::thin_seen_whole`] reads; with
+/// fewer it keeps the checkerboard. Half of Table 1's streak (15800 pixels) gives its
+/// radiance to 0.06 % rms over seeds (0.02 % from the checkerboard); half of a far 1.5 x
+/// 1.2 m light's gave its red 1.0 % high (0.3 % from the checkerboard), and the harbour
+/// pair's reflections (5100 pixels thinned) are kept whole.
+pub const THIN_MIN_WATER_PIXELS: usize = 10_000;
 
 /// Default lobe samples per pixel of the joint fit.
 pub const DEFAULT_JOINT_SAMPLES: u32 = 72;
@@ -338,5 +365,35 @@ mod tests {
         assert_eq!(share(4_000_001), PixelShare::WaterBlocks(3));
         assert_eq!(share(4000 * 3000), PixelShare::WaterBlocks(4));
         assert_eq!(share(8192 * 5464), PixelShare::WaterBlocks(7));
+    }
+
+    /// Only a checkerboard is thinned, only when asked, and only when every light is seen
+    /// whole: a larger photo's blocks, every pixel and the search's quarter stay as they are.
+    #[test]
+    fn a_checkerboard_is_thinned_where_every_lamp_pins_its_light() {
+        let options = |pixels, thin_seen_whole| super::JointOptions {
+            pixels,
+            thin_seen_whole,
+            ..super::JointOptions::new(crate::optics::ReflectionModel::new(500.0, 1.33), 1)
+        };
+        let board = PixelShare::Checkerboard;
+        assert_eq!(
+            options(board, true).share_for(true),
+            PixelShare::WaterBlocks(2)
+        );
+        assert_eq!(options(board, true).share_for(false), board);
+        assert_eq!(options(board, false).share_for(true), board);
+        for other in [
+            PixelShare::All,
+            PixelShare::Quarter,
+            PixelShare::WaterBlocks(2),
+            PixelShare::WaterBlocks(4),
+        ] {
+            assert_eq!(options(other, true).share_for(true), other);
+        }
+        assert!(
+            !super::JointOptions::new(crate::optics::ReflectionModel::new(500.0, 1.33), 1)
+                .thin_seen_whole
+        );
     }
 }

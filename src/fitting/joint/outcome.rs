@@ -1,7 +1,7 @@
 //! What a joint fit returns ([`JointOutcome`]).
 
 use super::uncertainty::{edge_statuses, Uncertainty};
-use super::{ModelledPixel, Split};
+use super::{ModelledPixel, PixelShare, Split};
 use crate::fitting::{FittedLight, Rect};
 use crate::progress::Reporter;
 
@@ -15,6 +15,8 @@ pub struct JointOutcome {
     /// Pixels in the fitted region: the water pixels and, with the direct view, those that
     /// see a light's wall directly.
     pub pixels: usize,
+    /// Which pixels of its region the fit read ([`JointOptions::thin_seen_whole`](super::JointOptions::thin_seen_whole)).
+    pub share: PixelShare,
     /// Residual sum of squares per pixel and channel at the optimum (radiance units squared).
     pub residual_variance: f64,
     /// The fit's cost at the optimum: the residual sum of squares less the samples' own noise
@@ -55,6 +57,7 @@ impl JointOutcome {
             lights: Vec::new(),
             uncertainty: Vec::new(),
             pixels: 0,
+            share: PixelShare::Checkerboard,
             residual_variance: 0.0,
             cost: 0.0,
             timings: Vec::new(),
