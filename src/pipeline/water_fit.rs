@@ -261,14 +261,12 @@ impl Run<'_> {
                 ));
                 // Out of frame the reflections alone cannot tell stacked lights of one colour
                 // from one (joint fit's `stacked_as_one`), and the residual is the glitter,
-                // whose noise weights the final fit (`glitter_weights`). The water pixels
-                // give the slopes too: the final fit reads the share the search's did.
+                // whose noise weights the final fit (`glitter_weights`).
                 let final_fit = JointOptions {
                     model,
                     stacked_as_one: true,
                     glitter_weights: true,
                     close_regions: false,
-                    thin_seen_whole: false,
                     ..self.joint_options(j, j.reading)
                 };
                 let est = estimate_slopes(
@@ -293,8 +291,7 @@ impl Run<'_> {
                 found.timings.extend(est.timings);
                 found.splits = est.splits;
                 found.reading = Some(j.reading);
-                // The final fit read its reading's share, not what an exact fit before read.
-                found.share = None;
+                found.share = Some(est.share);
                 let estimated = !found.lights.is_empty();
                 if estimated {
                     self.refit_overlaps(&est.water, &est.start, &final_fit, j, found)?;

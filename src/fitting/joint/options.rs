@@ -105,8 +105,9 @@ pub struct JointOptions<'a> {
     /// [`THIN_MIN_WATER_PIXELS`] water pixels: the images pin every edge, and the water
     /// pixels are left the radiances, which half of a large streak's give as well to a few
     /// hundredths of a percent, in about two thirds of the time (docs/decisions.md). Only a
-    /// checkerboard is thinned. Off by default; a fit whose cost is compared with others' (a
-    /// search) leaves it off.
+    /// checkerboard is thinned. Off by default. Fits whose costs are compared (a search)
+    /// must read the same pixels: the slope search's fits all start alike, so they thin
+    /// alike; the gloss search's read their own quarter.
     pub thin_seen_whole: bool,
 }
 

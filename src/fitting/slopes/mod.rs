@@ -51,7 +51,8 @@ use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
 use super::joint::direct_start::enclosing_image;
 use super::joint::{
-    fit_joint_with, place_starts, JointOptions, Lobe, ProposalCache, Reweight, Split, Uncertainty,
+    fit_joint_with, place_starts, JointOptions, Lobe, PixelShare, ProposalCache, Reweight, Split,
+    Uncertainty,
 };
 use super::{
     fit_paper_with, FitOptions, FitOutcome, FittedLight, Rect, Skipped, StreakObservation,
@@ -129,6 +130,8 @@ pub struct SlopeEstimate {
     pub splits: Vec<Split>,
     /// Lobe samples per traced pixel of the paper's estimate every fit started from.
     pub start_samples: u32,
+    /// Which pixels the final fit read ([`super::joint::JointOutcome::share`]).
+    pub share: PixelShare,
 }
 
 /// Estimates the slope variances over `surface` from the start `start_variance` (totals,
@@ -232,6 +235,7 @@ pub fn estimate_slopes(
             correlation_area: 1.0,
             splits: Vec::new(),
             start_samples,
+            share: final_fit.pixels,
         });
     }
     let start = match placed_start {
@@ -254,6 +258,8 @@ pub fn estimate_slopes(
         // The final fit's share, so that its residual's correlation area, counted over the
         // pixels it read, grows the curvature of fits over the same share.
         pixels: final_fit.pixels,
+        // Every fit of the search starts alike, so each thins alike.
+        thin_seen_whole: final_fit.thin_seen_whole,
         starts_placed: true,
         ..JointOptions::new(model, paper.seed)
     };
@@ -282,6 +288,10 @@ pub fn estimate_slopes(
     // The lights the first fit saw whole in the photo, by start light: every later fit holds
     // them there (module doc).
     let whole: std::cell::OnceCell<Vec<Option<Rect>>> = std::cell::OnceCell::new();
+    // The pixels the first fit read (thinned or not, `JointOptions::thin_seen_whole`): the
+    // final fit reads the same share, so that the residual's correlation area it measures
+    // grows the search's curvature over the pixels that made it.
+    let search_share: std::cell::OnceCell<PixelShare> = std::cell::OnceCell::new();
     // The `number`-th fit, at variances `v`.
     let eval = |v: [f32; 2], number: usize| -> Result<(Point, Vec<FittedLight>)> {
         final_fit.progress.stage(&format!(
@@ -314,6 +324,7 @@ pub fn estimate_slopes(
         )?;
         if whole.get().is_none() {
             let _ = whole.set(fit.to_hold("slope search", final_fit.progress));
+            let _ = search_share.set(fit.share);
         }
         if weighted && search_scales.get().is_none() {
             if let Some(s) = fit.row_scales.clone() {
@@ -425,6 +436,8 @@ pub fn estimate_slopes(
         &paper_fit.lights,
         &JointOptions {
             model,
+            pixels: search_share.get().copied().unwrap_or(final_fit.pixels),
+            thin_seen_whole: false,
             ..*final_fit
         },
     )?;
@@ -435,7 +448,7 @@ pub fn estimate_slopes(
         photo.width,
         &fit.modelled,
         scaled_pixels(MAX_LAG, photo.height, scene.camera.yfov),
-        final_fit.pixels,
+        fit.share,
     );
     let sigma_ln = sigma_ln.map(|s| s.map(|s| s * area.sqrt() as f32));
     let lights = fit.lights_with_statuses();
@@ -465,6 +478,7 @@ pub fn estimate_slopes(
         correlation_area: area,
         splits: fit.splits,
         start_samples,
+        share: fit.share,
     })
 }
 
