@@ -1,4 +1,5 @@
-//! Ray tracing against the scene: one obvhs BVH over every triangle, with a watertight
+//! Ray tracing against the scene: obvhs BVHs over tiles of nearby triangles, each built when
+//! a ray first reaches it (`tiles`), under a BVH over the tiles' boxes, with a watertight
 //! ray/triangle test (Woop, Benthin and Wald 2013).
 //!
 //! obvhs's own Möller-Trumbore test lets rays along shared edges of the water grid leak
@@ -6,15 +7,23 @@
 //! water. The watertight test decides every edge consistently for both triangles that share
 //! it. Boxes are padded a little so that a hit exactly on a box face is not culled.
 
-use std::time::Duration;
+mod tiles;
 
 use glam::{Vec3, Vec3A};
 use obvhs::{
     aabb::Aabb,
-    cwbvh::{builder::build_cwbvh, CwBvh},
+    cwbvh::CwBvh,
     ray::{Ray, RayHit},
-    Boundable, BvhBuildParams,
+    Boundable,
 };
+
+use tiles::Tile;
+
+/// The most triangles a tile holds: small enough that the tiles no ray reaches are left
+/// unbuilt (on the Table 1 scene 30 of 129 tiles; the camera sees about 40 % of its water), large
+/// enough that the top level stays a few nodes deep. From 2048 to 32768 the default fit of
+/// Table 1 took the same time to within the machine's noise (docs/decisions.md).
+pub const TILE_TRIANGLES: usize = 4096;
 
 /// A triangle as the tracer stores it.
 #[derive(Clone, Copy, Debug)]
@@ -50,14 +59,14 @@ pub struct Hit {
     pub barycentric: [f32; 3],
 }
 
-/// A BVH over triangles with closest-hit and occlusion queries.
+/// BVHs over triangles with closest-hit and occlusion queries.
 pub struct Tracer {
-    bvh: Option<CwBvh>,
-    /// Triangles reordered to the BVH's leaf order, so that the traversal's primitive id
-    /// indexes them directly (5-15 % faster than an indirection, method §8).
-    ordered: Vec<Triangle>,
-    /// For each entry of `ordered`, its index in the caller's list.
-    original_index: Vec<u32>,
+    /// The BVH over the tiles' boxes (`None` when there is no triangle).
+    top: Option<CwBvh>,
+    /// The tiles, in the top level's leaf order.
+    tiles: Vec<Tile>,
+    /// How many triangles there are.
+    len: usize,
     /// This tracer's own number, unique in the process ([`Tracer::id`]).
     id: u64,
 }
@@ -191,45 +200,42 @@ fn nudge_direction(dir: Vec3) -> Vec3 {
 }
 
 impl Tracer {
-    /// Builds the BVH over `triangles` (in any order; hits report indices into this list).
+    /// Builds the tiles' top level over `triangles` (in any order; hits report indices into
+    /// this list); each tile's BVH is built when a ray first reaches its box.
     pub fn new(triangles: &[Triangle]) -> Self {
-        if triangles.is_empty() {
-            return Tracer {
-                bvh: None,
-                ordered: Vec::new(),
-                original_index: Vec::new(),
-                id: next_id(),
-            };
-        }
-        // The cheapest preset: on the sample scene (518k triangles, mostly the water's
-        // regular grid) it builds in 0.32 s instead of medium's 0.56 s and traces as fast
-        // (reflected rays 6.51 against 6.44 M/s; docs/decisions.md, "The BVH built with obvhs's `very_fast_build`").
-        let bvh = build_cwbvh(
-            triangles,
-            BvhBuildParams::very_fast_build(),
-            &mut Duration::default(),
-        );
-        let original_index = bvh.primitive_indices.clone();
-        let ordered = original_index
-            .iter()
-            .map(|&i| triangles[i as usize])
-            .collect();
+        Self::with_tiles_of(triangles, TILE_TRIANGLES)
+    }
+
+    /// As [`Tracer::new`], with at most `per_tile` triangles a tile.
+    pub fn with_tiles_of(triangles: &[Triangle], per_tile: usize) -> Self {
+        let (top, tiles) = if triangles.is_empty() {
+            (None, Vec::new())
+        } else {
+            let (top, tiles) = tiles::top_level(tiles::tiles(triangles, per_tile));
+            (Some(top), tiles)
+        };
         Tracer {
-            bvh: Some(bvh),
-            ordered,
-            original_index,
+            top,
+            tiles,
+            len: triangles.len(),
             id: next_id(),
         }
     }
 
+    /// How many tiles there are, and how many of them have been built so far.
+    pub fn tiles_built(&self) -> (usize, usize) {
+        let built = self.tiles.iter().filter(|t| t.is_built()).count();
+        (self.tiles.len(), built)
+    }
+
     /// Number of triangles.
     pub fn len(&self) -> usize {
-        self.ordered.len()
+        self.len
     }
 
     /// True when there is nothing to hit.
     pub fn is_empty(&self) -> bool {
-        self.ordered.is_empty()
+        self.len == 0
     }
 
     /// A number no other tracer of this process has: what is cached from its hits is kept
@@ -240,47 +246,65 @@ impl Tracer {
 
     /// The closest hit along `origin + t dir` with `tmin < t < tmax`; `dir` must be unit length.
     pub fn closest_hit(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
-        let bvh = self.bvh.as_ref()?;
+        let top = self.top.as_ref()?;
         let dir = nudge_direction(dir);
         let wray = WatertightRay::new(origin, dir);
         let ray = Ray::new(origin.into(), dir.into(), tmin, tmax);
-        let mut hit = RayHit::none();
-        let mut bary = [0.0f32; 3];
-        let ordered = &self.ordered;
-        bvh.ray_traverse(ray, &mut hit, |r, id| {
-            match wray.intersect(&ordered[id], tmin, r.tmax) {
-                Some((t, b)) => {
-                    bary = b;
-                    t
-                }
-                None => f32::INFINITY,
+        let mut top_hit = RayHit::none();
+        let mut best = None;
+        top.ray_traverse(ray, &mut top_hit, |r, tile| {
+            let built = self.tiles[tile].built();
+            let mut hit = RayHit::none();
+            let mut bary = [0.0f32; 3];
+            let ordered = &built.ordered;
+            built.bvh.ray_traverse(
+                Ray::new(origin.into(), dir.into(), tmin, r.tmax),
+                &mut hit,
+                |r, id| match wray.intersect(&ordered[id], tmin, r.tmax) {
+                    Some((t, b)) => {
+                        bary = b;
+                        t
+                    }
+                    None => f32::INFINITY,
+                },
+            );
+            if hit.t < r.tmax {
+                // `bary` belongs to the last accepted candidate, which is the closest one
+                // because each accepted hit shrinks tmax; a later tile is searched only
+                // closer than this hit.
+                best = Some(Hit {
+                    t: hit.t,
+                    triangle: built.original_index[hit.primitive_id as usize],
+                    barycentric: bary,
+                });
+                hit.t
+            } else {
+                f32::INFINITY
             }
         });
-        if hit.t < tmax {
-            // `bary` belongs to the last accepted candidate, which is the closest one
-            // because each accepted hit shrinks tmax.
-            Some(Hit {
-                t: hit.t,
-                triangle: self.original_index[hit.primitive_id as usize],
-                barycentric: bary,
-            })
-        } else {
-            None
-        }
+        best.filter(|h| h.t < tmax)
     }
 
     /// True when something lies along `origin + t dir` with `tmin < t < tmax`.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> bool {
-        let Some(bvh) = self.bvh.as_ref() else {
+        let Some(top) = self.top.as_ref() else {
             return false;
         };
         let dir = nudge_direction(dir);
         let wray = WatertightRay::new(origin, dir);
         let ray = Ray::new(origin.into(), dir.into(), tmin, tmax);
-        let ordered = &self.ordered;
-        !bvh.ray_traverse_miss(ray, |_, id| {
-            wray.intersect(&ordered[id], tmin, tmax)
-                .map_or(f32::INFINITY, |(t, _)| t)
+        !top.ray_traverse_miss(ray, |_, tile| {
+            let built = self.tiles[tile].built();
+            let ordered = &built.ordered;
+            let mut found = f32::INFINITY;
+            built.bvh.ray_traverse_miss(ray, |_, id| {
+                let t = wray
+                    .intersect(&ordered[id], tmin, tmax)
+                    .map_or(f32::INFINITY, |(t, _)| t);
+                found = found.min(t);
+                t
+            });
+            found
         })
     }
 
@@ -295,14 +319,16 @@ impl Tracer {
         let dir = nudge_direction(dir);
         let wray = WatertightRay::new(origin, dir);
         let mut best: Option<Hit> = None;
-        for (k, tri) in self.ordered.iter().enumerate() {
-            let limit = best.map_or(tmax, |b| b.t);
-            if let Some((t, b)) = wray.intersect(tri, tmin, limit) {
-                best = Some(Hit {
-                    t,
-                    triangle: self.original_index[k],
-                    barycentric: b,
-                });
+        for built in self.tiles.iter().map(Tile::built) {
+            for (k, tri) in built.ordered.iter().enumerate() {
+                let limit = best.map_or(tmax, |b| b.t);
+                if let Some((t, b)) = wray.intersect(tri, tmin, limit) {
+                    best = Some(Hit {
+                        t,
+                        triangle: built.original_index[k],
+                        barycentric: b,
+                    });
+                }
             }
         }
         best

@@ -1,5 +1,6 @@
-//! The BVH finds the same closest hits as testing every triangle, and rays along shared
-//! edges of a water grid never slip through it.
+//! The BVH finds the same closest hits as testing every triangle, whether it holds the
+//! triangles in one tile or many, rays along shared edges of a water grid never slip through
+//! it, and a tile's BVH is built only when a ray reaches it.
 
 use glam::Vec3;
 use streaklight::random::Rng;
@@ -30,11 +31,18 @@ fn closest_hits_agree_with_brute_force() {
             }
         })
         .collect();
-    let tracer = Tracer::new(&tris);
+    // One tile, and tiles of 40 triangles (large ones, from the random corners, apart).
+    for tracer in [Tracer::new(&tris), Tracer::with_tiles_of(&tris, 40)] {
+        agrees_with_brute_force(&tracer, &tris, &mut rng);
+    }
+    assert!(Tracer::with_tiles_of(&tris, 40).tiles_built().0 >= 3000 / 40);
+}
+
+fn agrees_with_brute_force(tracer: &Tracer, tris: &[Triangle], rng: &mut Rng) {
     let mut hits = 0;
     for _ in 0..3000 {
         let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 24.0 - 12.0;
-        let dir = random_unit(&mut rng);
+        let dir = random_unit(rng);
         let a = tracer.closest_hit(origin, dir, 0.0, f32::INFINITY);
         let b = tracer.closest_hit_brute_force(origin, dir, 0.0, f32::INFINITY);
         match (a, b) {
@@ -98,9 +106,9 @@ fn grid(n: usize, bumpy: bool) -> (Vec<Triangle>, Vec<Vec3>, Vec<[usize; 2]>) {
 
 #[test]
 fn rays_along_shared_edges_never_pass_through_the_grid() {
-    for bumpy in [false, true] {
+    for (bumpy, per_tile) in [(false, usize::MAX), (true, usize::MAX), (true, 37)] {
         let (tris, v, edges) = grid(16, bumpy);
-        let tracer = Tracer::new(&tris);
+        let tracer = Tracer::with_tiles_of(&tris, per_tile);
         let mut rng = Rng::new(7, bumpy as u64);
         let mut rays = 0;
         for e in &edges {
@@ -135,6 +143,68 @@ fn rays_along_shared_edges_never_pass_through_the_grid() {
         }
         assert!(rays > 10_000);
     }
+}
+
+/// Over a grid of 128 x 128 cells with a wall of two large triangles behind it, rays from a
+/// camera above one corner of the grid build the tiles around that corner and the wall's,
+/// not the rest, and find what testing every triangle finds.
+#[test]
+fn tiles_out_of_reach_are_not_built() {
+    let (mut tris, _, _) = grid(128, true);
+    // The grid spans -2..30 in x and z; the wall stands at z = -2.5, 40 m wide and 10 m tall.
+    let wall = [
+        Vec3::new(-20.0, -1.0, -2.5),
+        Vec3::new(20.0, -1.0, -2.5),
+        Vec3::new(20.0, 9.0, -2.5),
+        Vec3::new(-20.0, 9.0, -2.5),
+    ];
+    tris.push(Triangle {
+        vertices: [wall[0], wall[1], wall[2]],
+    });
+    tris.push(Triangle {
+        vertices: [wall[0], wall[2], wall[3]],
+    });
+    let tracer = Tracer::with_tiles_of(&tris, 512);
+    let (tiles, built) = tracer.tiles_built();
+    // 32,768 grid triangles in tiles of 512 at most, and the wall's tile.
+    assert_eq!((tiles, built), (65, 0));
+    let mut rng = Rng::new(3, 1);
+    let camera = Vec3::new(-1.0, 1.0, -1.0);
+    for _ in 0..2000 {
+        // Down onto the grid's corner within 2 m of the camera, or up towards the wall.
+        let target = if rng.next_f32() < 0.5 {
+            Vec3::new(rng.next_f32() * 2.0 - 2.0, 0.0, rng.next_f32() * 2.0 - 2.0)
+        } else {
+            Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 6.0, -2.5)
+        };
+        let dir = (target - camera).normalize();
+        let a = tracer.closest_hit(camera, dir, 0.0, f32::INFINITY);
+        let b = tracer.closest_hit_brute_force(camera, dir, 0.0, f32::INFINITY);
+        assert_eq!(a.map(|h| (h.t, h.triangle)), b.map(|h| (h.t, h.triangle)));
+        assert!(a.is_some(), "every ray ends on the grid or the wall");
+    }
+    let wall_hits = (0..200)
+        .filter(|k| {
+            let dir = (Vec3::new(*k as f32 * 0.02 - 2.0, 4.0, -2.5) - camera).normalize();
+            let hit = tracer.closest_hit(camera, dir, 0.0, f32::INFINITY);
+            hit.is_some_and(|h| h.triangle as usize >= tris.len() - 2)
+        })
+        .count();
+    assert_eq!(wall_hits, 200);
+    // The brute force built every tile: count on a fresh tracer.
+    let fresh = Tracer::with_tiles_of(&tris, 512);
+    for _ in 0..2000 {
+        let target = if rng.next_f32() < 0.5 {
+            Vec3::new(rng.next_f32() * 2.0 - 2.0, 0.0, rng.next_f32() * 2.0 - 2.0)
+        } else {
+            Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 6.0, -2.5)
+        };
+        fresh.closest_hit(camera, (target - camera).normalize(), 0.0, f32::INFINITY);
+    }
+    let (_, built) = fresh.tiles_built();
+    // The corner's 2 x 2 m is 1/256 of the grid's area; with the tiles next to it that a ray
+    // crosses low and the wall's, a handful are built.
+    assert!((2..=8).contains(&built), "{built} of 65 tiles built");
 }
 
 /// A ray leaving a large triangle from just above it never hits it: the reflected rays of a

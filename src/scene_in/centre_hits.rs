@@ -8,6 +8,8 @@
 //! At 4000 x 3000 a box holds millions of pixels and its trace took about 2 s a fit. The hits
 //! depend only on the scene's triangles, the camera and the image size, so a box traced once
 //! serves every later box inside it, hit for hit: the results are the same to the last bit.
+//! The water mask (`crate::water_mask`) traces the whole image this way first, so up to
+//! [`KEPT_PIXELS`] every later box is read from its hits.
 //!
 //! The boxes are kept with their key (the tracer's identity, the camera, the image size), so
 //! a scene whose tracer is rebuilt or whose camera is moved never reads a stale hit, and up
@@ -67,7 +69,8 @@ pub struct BoxHits {
 impl BoxHits {
     /// The first hit of pixel `(x, y)`'s centre ray: the triangle's index in
     /// [`Scene::triangles`] and the distance, or `None` when it meets nothing. `None` too for
-    /// a pixel outside the box or one `skip` left out.
+    /// a pixel outside the box, and for one `skip` left out unless a box traced before held
+    /// its hit.
     pub fn get(&self, x: u32, y: u32) -> Option<(u32, f32)> {
         let (x0, y0, x1, y1) = self.area;
         if x < x0 || x > x1 || y < y0 || y > y1 {
@@ -251,6 +254,8 @@ mod tests {
         let (mut scene, photo, water, _) = crate::samples::fixture("table1.png");
         let size = photo.width;
         assert_eq!(photo.height, size);
+        // The fixture's water mask traced the whole image: start with nothing kept.
+        scene.centre_hit_cache = CentreHitCache::default();
         let water_skip = |i: usize| water[i];
         // A box across the wall, the light and the horizon: the water pixels left out.
         let outer = (200, 150, 420, 360);
@@ -289,5 +294,11 @@ mod tests {
         let rebuilt = scene.centre_hits(inner, size, size, &none);
         assert!(!Arc::ptr_eq(&moved.hits, &rebuilt.hits));
         assert_traced(&scene, &rebuilt, inner, size, &none);
+        // The whole image, as the water mask traces it, serves every box after it, with the
+        // hits of the pixels a later box leaves out.
+        let whole = scene.centre_hits((0, 0, size - 1, size - 1), size, size, &none);
+        let later = scene.centre_hits(outer, size, size, &water_skip);
+        assert!(Arc::ptr_eq(&whole.hits, &later.hits));
+        assert_traced(&scene, &later, outer, size, &none);
     }
 }

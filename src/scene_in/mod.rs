@@ -1,7 +1,8 @@
 //! Step 1 of method §5: load the scene.
 //!
 //! The node hierarchy is baked to world space in f64, recentred on the camera, and only then
-//! rounded to f32. Every triangle goes into one BVH ([`crate::tracing::Tracer`]).
+//! rounded to f32. Every triangle goes into the tracer ([`crate::tracing::Tracer`]: BVHs
+//! over tiles of nearby triangles, each built when a ray first reaches it).
 
 mod area_lights;
 mod camera;
