@@ -174,6 +174,48 @@ impl WatertightRay {
     }
 }
 
+/// The closest hit of `ray` (its `wray` for the triangle test) in one tile's BVH.
+#[inline]
+fn closest_in(built: &tiles::Built, wray: &WatertightRay, ray: Ray) -> Option<Hit> {
+    let mut hit = RayHit::none();
+    let mut bary = [0.0f32; 3];
+    let ordered = &built.ordered;
+    let tmin = ray.tmin;
+    built.bvh.ray_traverse(ray, &mut hit, |r, id| {
+        match wray.intersect(&ordered[id], tmin, r.tmax) {
+            Some((t, b)) => {
+                bary = b;
+                t
+            }
+            None => f32::INFINITY,
+        }
+    });
+    // `bary` belongs to the last accepted candidate, which is the closest one because each
+    // accepted hit shrinks tmax.
+    (hit.t < ray.tmax).then(|| Hit {
+        t: hit.t,
+        triangle: built.original_index[hit.primitive_id as usize],
+        barycentric: bary,
+    })
+}
+
+/// The distance of some hit of `ray` in one tile's BVH, if there is one.
+#[inline]
+fn occluded_in(built: &tiles::Built, wray: &WatertightRay, ray: Ray) -> Option<f32> {
+    let ordered = &built.ordered;
+    let mut found = None;
+    built.bvh.ray_traverse_miss(ray, |_, id| {
+        let t = wray
+            .intersect(&ordered[id], ray.tmin, ray.tmax)
+            .map_or(f32::INFINITY, |(t, _)| t);
+        if t < ray.tmax {
+            found = Some(t);
+        }
+        t
+    });
+    found
+}
+
 /// gamma(n) of the floating-point error analysis: n units of roundoff, n u / (1 - n u).
 fn gamma(n: f32) -> f32 {
     let u = f32::EPSILON * 0.5;
@@ -250,39 +292,26 @@ impl Tracer {
         let dir = nudge_direction(dir);
         let wray = WatertightRay::new(origin, dir);
         let ray = Ray::new(origin.into(), dir.into(), tmin, tmax);
+        if let [tile] = self.tiles.as_slice() {
+            return closest_in(tile.built(), &wray, ray);
+        }
         let mut top_hit = RayHit::none();
         let mut best = None;
         top.ray_traverse(ray, &mut top_hit, |r, tile| {
-            let built = self.tiles[tile].built();
-            let mut hit = RayHit::none();
-            let mut bary = [0.0f32; 3];
-            let ordered = &built.ordered;
-            built.bvh.ray_traverse(
-                Ray::new(origin.into(), dir.into(), tmin, r.tmax),
-                &mut hit,
-                |r, id| match wray.intersect(&ordered[id], tmin, r.tmax) {
-                    Some((t, b)) => {
-                        bary = b;
-                        t
-                    }
-                    None => f32::INFINITY,
-                },
-            );
-            if hit.t < r.tmax {
-                // `bary` belongs to the last accepted candidate, which is the closest one
-                // because each accepted hit shrinks tmax; a later tile is searched only
-                // closer than this hit.
-                best = Some(Hit {
-                    t: hit.t,
-                    triangle: built.original_index[hit.primitive_id as usize],
-                    barycentric: bary,
-                });
-                hit.t
-            } else {
-                f32::INFINITY
+            // A later tile is searched only closer than the best hit so far.
+            let ray = Ray {
+                tmax: r.tmax,
+                ..ray
+            };
+            match closest_in(self.tiles[tile].built(), &wray, ray) {
+                Some(hit) => {
+                    best = Some(hit);
+                    hit.t
+                }
+                None => f32::INFINITY,
             }
         });
-        best.filter(|h| h.t < tmax)
+        best
     }
 
     /// True when something lies along `origin + t dir` with `tmin < t < tmax`.
@@ -293,18 +322,11 @@ impl Tracer {
         let dir = nudge_direction(dir);
         let wray = WatertightRay::new(origin, dir);
         let ray = Ray::new(origin.into(), dir.into(), tmin, tmax);
+        if let [tile] = self.tiles.as_slice() {
+            return occluded_in(tile.built(), &wray, ray).is_some();
+        }
         !top.ray_traverse_miss(ray, |_, tile| {
-            let built = self.tiles[tile].built();
-            let ordered = &built.ordered;
-            let mut found = f32::INFINITY;
-            built.bvh.ray_traverse_miss(ray, |_, id| {
-                let t = wray
-                    .intersect(&ordered[id], tmin, tmax)
-                    .map_or(f32::INFINITY, |(t, _)| t);
-                found = found.min(t);
-                t
-            });
-            found
+            occluded_in(self.tiles[tile].built(), &wray, ray).unwrap_or(f32::INFINITY)
         })
     }
 
