@@ -8,8 +8,8 @@
 //! At 4000 x 3000 a box holds millions of pixels and its trace took about 2 s a fit. The hits
 //! depend only on the scene's triangles, the camera and the image size, so a box traced once
 //! serves every later box inside it, hit for hit: the results are the same to the last bit.
-//! The water mask (`crate::water_mask`) traces the whole image this way first, so up to
-//! [`KEPT_PIXELS`] every later box is read from its hits.
+//! The water mask (`crate::water_mask`) traces the whole image this way first when it holds
+//! at most [`KEPT_PIXELS`], so every later box is read from its hits.
 //!
 //! The boxes are kept with their key (the tracer's identity, the camera, the image size), so
 //! a scene whose tracer is rebuilt or whose camera is moved never reads a stale hit, and up
@@ -22,7 +22,7 @@ use rayon::prelude::*;
 use super::Scene;
 
 /// The most pixels the kept boxes hold together (8 bytes each).
-const KEPT_PIXELS: usize = 8 << 20;
+pub const KEPT_PIXELS: usize = 8 << 20;
 
 /// A pixel's entry: the triangle first hit (or one of the two markers) and the distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -116,6 +116,17 @@ impl Scene {
         }
     }
 
+    /// The first hit (`Scene::tracer`) of the camera ray through the centre of pixel `(x, y)`
+    /// of a `width` x `height` image, traced now: the triangle and the distance.
+    pub fn centre_hit(&self, x: u32, y: u32, width: u32, height: u32) -> Option<(u32, f32)> {
+        let dir = self
+            .camera
+            .direction(x as f32 + 0.5, y as f32 + 0.5, width, height);
+        self.tracer
+            .closest_hit(self.camera.position, dir, 0.0, f32::INFINITY)
+            .map(|hit| (hit.triangle, hit.t))
+    }
+
     /// The first hit (`Scene::tracer`) of the camera ray through the centre of every pixel
     /// of `area` (inclusive, inside a `width` x `height` image) but those `skip` (by row-major
     /// pixel index) leaves out, from a box traced before when one holds them all (module
@@ -153,7 +164,6 @@ impl Scene {
                 return kept;
             }
         }
-        let origin = self.camera.position;
         let hits: Vec<Entry> = (y0..=y1)
             .into_par_iter()
             .flat_map_iter(|y| {
@@ -164,14 +174,8 @@ impl Scene {
                             t: 0.0,
                         };
                     }
-                    let dir = self
-                        .camera
-                        .direction(x as f32 + 0.5, y as f32 + 0.5, width, height);
-                    match self.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY) {
-                        Some(hit) => Entry {
-                            triangle: hit.triangle,
-                            t: hit.t,
-                        },
+                    match self.centre_hit(x, y, width, height) {
+                        Some((triangle, t)) => Entry { triangle, t },
                         None => Entry {
                             triangle: MISS,
                             t: 0.0,

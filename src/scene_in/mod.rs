@@ -19,7 +19,7 @@ use glam::{DVec3, Vec3};
 
 pub use area_lights::AreaLight;
 pub use camera::Camera;
-pub use centre_hits::{BoxHits, PixelBox};
+pub use centre_hits::{BoxHits, PixelBox, KEPT_PIXELS};
 pub use meshes::{is_fallback_quad, TriangleSource};
 pub use nodes::{world_instances, NodeInstance};
 pub use water::{gloss_from_roughness, roughness_from_gloss, Water, DEFAULT_GLOSS, WATER_IOR};
