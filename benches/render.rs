@@ -41,7 +41,7 @@ fn main() {
     let r = best.expect("three runs");
     println!("threads: {}", rayon::current_num_threads());
     println!(
-        "scene generation: {generate:.3} s; load + BVH build ({} triangles): {load_s:.3} s",
+        "scene generation: {generate:.3} s; load ({} triangles; the tiles' BVHs are built by the first rays): {load_s:.3} s",
         scene.triangles.len()
     );
     println!(
