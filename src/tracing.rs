@@ -20,9 +20,9 @@ use obvhs::{
 use tiles::Tile;
 
 /// The most triangles a tile holds: small enough that the tiles no ray reaches are left
-/// unbuilt (on the Table 1 scene 30 of 129 tiles; the camera sees about 40 % of its water), large
-/// enough that the top level stays a few nodes deep. From 2048 to 32768 the default fit of
-/// Table 1 took the same time to within the machine's noise (docs/decisions.md).
+/// unbuilt (on the Table 1 scene 30 of 129 tiles; the camera sees about 40 % of its water),
+/// large enough that the top level stays a few nodes deep. From 2048 to 32768 the default
+/// fit of Table 1 took the same time to within the machine's noise (docs/decisions.md).
 pub const TILE_TRIANGLES: usize = 4096;
 
 /// A triangle as the tracer stores it.

@@ -6,7 +6,7 @@
 //! the tiles out of view are never built. The tiles come from halving the triangles at the
 //! median of their centres along the widest axis until each holds at most a tile's worth,
 //! so they stay balanced whatever the scene's layout. Triangles much larger than the usual
-//! one (a wall's quad over a fine water grid) go into a tile of their own, so that they do
+//! one (a wall's quad over a fine water grid) go into tiles of their own, so that they do
 //! not stretch a water tile's box over the whole scene.
 
 use std::ops::Range;
@@ -136,7 +136,7 @@ pub(super) fn tiles(triangles: &[Triangle], per_tile: usize) -> Vec<Tile> {
         } else {
             f32::INFINITY
         };
-        // Large triangles to the end of the order, in a tile of their own.
+        // Large triangles to the end of the order, in tiles of their own.
         let mut ends = order.len();
         let mut k = 0;
         while k < ends {
@@ -147,9 +147,8 @@ pub(super) fn tiles(triangles: &[Triangle], per_tile: usize) -> Vec<Tile> {
                 k += 1;
             }
         }
-        if ends < n {
-            ranges.push(ends..n);
-        }
+        // Many large ones (a city's facades) are cut into tiles among themselves.
+        split(&mut order, ends..n, &centres, per_tile, &mut ranges);
         ordinary = 0..ends;
     }
     split(&mut order, ordinary, &centres, per_tile, &mut ranges);
