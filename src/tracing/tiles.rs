@@ -13,7 +13,6 @@ use std::ops::Range;
 use std::sync::{Mutex, OnceLock};
 use std::time::Duration;
 
-use glam::Vec3A;
 use obvhs::{
     aabb::Aabb,
     cwbvh::{builder::build_cwbvh, CwBvh},
@@ -23,7 +22,7 @@ use obvhs::{
 use super::Triangle;
 
 /// A triangle is large, and kept out of the ordinary tiles, when its box's largest side is
-/// this many times the median triangle's.
+/// this many times the median triangle's (the median of an evenly spread sample).
 const LARGE_FACTOR: f32 = 16.0;
 
 /// The triangles of one tile and, once a ray has reached its box, their BVH.
@@ -113,94 +112,109 @@ fn build(triangles: &[Triangle], index: &[u32]) -> Built {
     }
 }
 
+/// A triangle's centre and its index, as the cuts move them: kept together so that cutting
+/// reads memory in order (with indices into a separate list of centres, cutting a grid of
+/// 8.29 M triangles into tiles took 0.95 s; this way 0.76 s).
+#[derive(Clone, Copy)]
+struct Item {
+    centre: [f32; 3],
+    index: u32,
+}
+
 /// Cuts `triangles` into tiles of at most `per_tile` triangles (the large ones apart).
 pub(super) fn tiles(triangles: &[Triangle], per_tile: usize) -> Vec<Tile> {
     let per_tile = per_tile.max(1);
     let n = triangles.len();
-    let mut order: Vec<u32> = (0..n as u32).collect();
-    let centres: Vec<Vec3A> = triangles
-        .iter()
-        .map(|t| Vec3A::from((t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0))
-        .collect();
-    let mut ranges = Vec::new();
-    let mut ordinary = 0..n;
-    if n > per_tile {
-        let size = |t: &Triangle| {
-            let [a, b, c] = t.vertices;
-            (a.max(b).max(c) - a.min(b).min(c)).max_element()
-        };
-        let mut sizes: Vec<f32> = triangles.iter().map(size).collect();
-        let median = *sizes.select_nth_unstable_by(n / 2, |a, b| a.total_cmp(b)).1;
-        let large = if median > 0.0 {
+    let size = |t: &Triangle| {
+        let [a, b, c] = t.vertices;
+        (a.max(b).max(c) - a.min(b).min(c)).max_element()
+    };
+    let large = if n > per_tile {
+        // The median of a sample of at most 65536, evenly spread over the list.
+        let step = n.div_ceil(1 << 16);
+        let mut sizes: Vec<f32> = triangles.iter().step_by(step).map(size).collect();
+        let half = sizes.len() / 2;
+        let median = *sizes.select_nth_unstable_by(half, |a, b| a.total_cmp(b)).1;
+        if median > 0.0 {
             median * LARGE_FACTOR
         } else {
             f32::INFINITY
-        };
-        // Large triangles to the end of the order, in tiles of their own.
-        let mut ends = order.len();
-        let mut k = 0;
-        while k < ends {
-            if size(&triangles[order[k] as usize]) > large {
-                ends -= 1;
-                order.swap(k, ends);
-            } else {
-                k += 1;
-            }
         }
-        // Many large ones (a city's facades) are cut into tiles among themselves.
-        split(&mut order, ends..n, &centres, per_tile, &mut ranges);
-        ordinary = 0..ends;
+    } else {
+        f32::INFINITY
+    };
+    let item = |(k, t): (usize, &Triangle)| Item {
+        centre: ((t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0).to_array(),
+        index: k as u32,
+    };
+    // The ordinary triangles first, the large ones after them, in tiles of their own; many
+    // large ones (a city's facades) are cut into tiles among themselves.
+    let is_large: Vec<bool> = triangles.iter().map(|t| size(t) > large).collect();
+    let mut items: Vec<Item> = triangles.iter().enumerate().map(item).collect();
+    let mut ordinary = n;
+    let mut k = 0;
+    while k < ordinary {
+        if is_large[items[k].index as usize] {
+            ordinary -= 1;
+            items.swap(k, ordinary);
+        } else {
+            k += 1;
+        }
     }
-    split(&mut order, ordinary, &centres, per_tile, &mut ranges);
+    // On one core: a tracer may be built lazily inside a parallel loop
+    // (`Scene::closest_hit_above_water`), where a rayon worker waiting for a half could take
+    // up a task of that loop which asks for this very tracer, and wait on itself.
+    let (first, rest) = items.split_at_mut(ordinary);
+    let mut ranges = Vec::new();
+    split(first, 0, per_tile, &mut ranges);
+    split(rest, ordinary, per_tile, &mut ranges);
     ranges
         .into_iter()
         .filter(|r| !r.is_empty())
         .map(|r| {
-            let index = order[r].to_vec();
+            let index: Vec<u32> = items[r].iter().map(|it| it.index).collect();
             let tris = index.iter().map(|&i| triangles[i as usize]).collect();
             Tile::new(tris, index)
         })
         .collect()
 }
 
-/// Halves `order[range]` at the median of the centres along their widest axis until each
-/// part holds at most `per_tile`.
-fn split(
-    order: &mut [u32],
-    range: Range<usize>,
-    centres: &[Vec3A],
-    per_tile: usize,
-    out: &mut Vec<Range<usize>>,
-) {
-    if range.len() <= per_tile {
-        out.push(range);
+/// Halves `items` at the median of their centres along their widest axis until each part
+/// holds at most `per_tile`, and puts the parts' ranges, offset by `start`, in `out`.
+fn split(items: &mut [Item], start: usize, per_tile: usize, out: &mut Vec<Range<usize>>) {
+    let whole = start..start + items.len();
+    if items.len() <= per_tile {
+        out.push(whole);
         return;
     }
-    let part = &mut order[range.clone()];
-    let (lo, hi) = part.iter().fold(
-        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &i| (lo.min(centres[i as usize]), hi.max(centres[i as usize])),
+    let (lo, hi) = items.iter().fold(
+        ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+        |(mut lo, mut hi), it| {
+            for a in 0..3 {
+                lo[a] = lo[a].min(it.centre[a]);
+                hi[a] = hi[a].max(it.centre[a]);
+            }
+            (lo, hi)
+        },
     );
-    let extent = hi - lo;
-    if extent.max_element().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        // Every centre at one point: nothing to cut along.
-        out.push(range);
-        return;
-    }
-    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+    let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
         0
-    } else if extent.y >= extent.z {
+    } else if extent[1] >= extent[2] {
         1
     } else {
         2
     };
-    let mid = part.len() / 2;
-    part.select_nth_unstable_by(mid, |&a, &b| {
-        centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
-    });
-    let cut = range.start + mid;
-    split(order, range.start..cut, centres, per_tile, out);
-    split(order, cut..range.end, centres, per_tile, out);
+    if extent[axis].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        // Every centre at one point: nothing to cut along.
+        out.push(whole);
+        return;
+    }
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |a, b| a.centre[axis].total_cmp(&b.centre[axis]));
+    let (left, right) = items.split_at_mut(mid);
+    split(left, start, per_tile, out);
+    split(right, start + mid, per_tile, out);
 }
 
 /// The tiles' top level: a BVH over their boxes (the tiles in its leaf order).
