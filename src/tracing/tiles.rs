@@ -28,7 +28,7 @@ const LARGE_FACTOR: f32 = 16.0;
 /// The triangles of one tile and, once a ray has reached its box, their BVH.
 pub(super) struct Tile {
     /// The box around every triangle of the tile (their padded boxes).
-    pub(super) aabb: Aabb,
+    aabb: Aabb,
     /// The tile's triangles and their indices in the tracer's list, until the BVH takes them.
     pending: Mutex<Option<(Vec<Triangle>, Vec<u32>)>>,
     built: OnceLock<Built>,
@@ -62,7 +62,10 @@ impl Tile {
         }
     }
 
-    /// The tile's BVH, built by the first caller (others wait for it).
+    /// The tile's BVH, built by the first caller (others wait for it). obvhs builds on the
+    /// calling thread (its `parallel` feature is off), so a rayon worker building a tile
+    /// never takes up another task of its loop meanwhile, one that could wait for this very
+    /// tile.
     pub(super) fn built(&self) -> &Built {
         self.built.get_or_init(|| {
             let (triangles, index) = self
