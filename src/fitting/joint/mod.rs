@@ -202,7 +202,7 @@ pub fn fit_joint_with(
         ));
     }
     if start.is_empty() {
-        return Ok(JointOutcome::empty());
+        return Ok(JointOutcome::empty(options.pixels));
     }
     // The footprints' stage counts from here: placing the starts traces the lamps' images.
     let t0 = Instant::now();
@@ -230,11 +230,13 @@ pub fn fit_joint_with(
     }
     let planes: Vec<&LightPlane> = start.iter().map(|l| &l.plane).collect();
     // A light on a lamp's whole direct image searches close around it where asked
-    // (`region_of_interest`, `JointOptions::close_regions`).
+    // (`region_of_interest`, `JointOptions::close_regions`); where every light is on one, a
+    // fit that may thin its pixels does (`JointOptions::share_for`).
+    let may_thin = options.share_for(true) != options.pixels;
     let images: Vec<Option<(Rect, f32)>> = start
         .iter()
         .map(|light| {
-            (options.direct_view && (options.close_regions || options.thin_seen_whole))
+            (options.direct_view && (options.close_regions || may_thin))
                 .then(|| enclosing_image(scene, photo, water, light))
                 .flatten()
         })
@@ -360,11 +362,10 @@ pub fn fit_joint_with(
         if !(gate.0)(&modelled) {
             return Ok(JointOutcome {
                 pixels: pixels.len(),
-                share,
                 timings: vec![("footprints".into(), footprint_seconds)],
                 modelled,
                 stopped_at_start: true,
-                ..JointOutcome::empty()
+                ..JointOutcome::empty(share)
             });
         }
     }

@@ -51,13 +51,13 @@ pub struct JointOutcome {
 }
 
 impl JointOutcome {
-    /// The outcome of a fit that fitted nothing.
-    pub(super) fn empty() -> Self {
+    /// The outcome of a fit that fitted nothing, over the pixels `share` gives.
+    pub(super) fn empty(share: PixelShare) -> Self {
         JointOutcome {
             lights: Vec::new(),
             uncertainty: Vec::new(),
             pixels: 0,
-            share: PixelShare::Checkerboard,
+            share,
             residual_variance: 0.0,
             cost: 0.0,
             timings: Vec::new(),
