@@ -353,6 +353,24 @@ fn gloss_auto_through_the_converter() {
         .filter(|l| l.starts_with("gloss search: joint fit "))
         .count();
     assert!(searched >= 3, "{lines:?}");
+    // The first fit's trace, the search's long step, is told as it goes: between its
+    // announcement and the second fit's, the trace of its search samples.
+    let first = lines
+        .iter()
+        .position(|l| l.starts_with("gloss search: joint fit 1 "))
+        .expect("the first fit announced");
+    let second = lines
+        .iter()
+        .position(|l| l.starts_with("gloss search: joint fit 2 "))
+        .expect("the second fit announced");
+    let search_samples = streaklight::fitting::gloss::GlossSearch::default().search_samples;
+    assert!(
+        lines[first..second]
+            .iter()
+            .any(|l| l.starts_with("joint fit: tracing the footprints")
+                && l.contains(&format!("{search_samples} samples each"))),
+        "{lines:?}"
+    );
     assert!(
         lines.iter().any(|l| l
             == &format!(

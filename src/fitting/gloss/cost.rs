@@ -107,6 +107,7 @@ impl Curve for &mut Cost<'_> {
                 start_gate: self.gate.filter(|_| self.evaluations.is_empty()),
                 starts_placed: true,
                 held: self.held.as_deref().unwrap_or(&[]),
+                progress: self.fit.progress,
                 ..JointOptions::new(
                     ReflectionModel {
                         gloss,
