@@ -78,15 +78,21 @@ fn next_id() -> u64 {
     NEXT_TRACER.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
-/// Per-ray constants of the watertight test: the axis permutation and the shear.
+/// Per-ray constants of the watertight test: the axis permutation and the shear, as the
+/// three rows that take a vertex (less the origin) to the sheared frame.
+///
+/// A row holds 1 at the permuted axis, the shear at the ray's major axis and 0 elsewhere, so
+/// its dot product rounds exactly as `a[kx] - sx a[kz]` does (a product by 1 or 0 is exact,
+/// adding 0 changes nothing, and the two terms that remain are added once), without
+/// indexing a vector by an axis known only at run time on every vertex.
 struct WatertightRay {
     origin: Vec3,
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    /// Gives the sheared x: `a[kx] - sx a[kz]`.
+    row_x: Vec3,
+    /// Gives the sheared y: `a[ky] - sy a[kz]`.
+    row_y: Vec3,
+    /// Gives the sheared z: `sz a[kz]`.
+    row_z: Vec3,
 }
 
 impl WatertightRay {
@@ -109,14 +115,20 @@ impl WatertightRay {
         if dir[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+        let row = |axis: usize, shear: f32| {
+            let mut r = Vec3::ZERO;
+            r[axis] = 1.0;
+            r[kz] = -shear;
+            r
+        };
+        let mut row_z = Vec3::ZERO;
+        row_z[kz] = sz;
         WatertightRay {
             origin,
-            kx,
-            ky,
-            kz,
-            sx: dir[kx] / dir[kz],
-            sy: dir[ky] / dir[kz],
-            sz: 1.0 / dir[kz],
+            row_x: row(kx, sx),
+            row_y: row(ky, sy),
+            row_z,
         }
     }
 
@@ -126,13 +138,9 @@ impl WatertightRay {
         let a = tri.vertices[0] - self.origin;
         let b = tri.vertices[1] - self.origin;
         let c = tri.vertices[2] - self.origin;
-        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
-        let ax = a[kx] - self.sx * a[kz];
-        let ay = a[ky] - self.sy * a[kz];
-        let bx = b[kx] - self.sx * b[kz];
-        let by = b[ky] - self.sy * b[kz];
-        let cx = c[kx] - self.sx * c[kz];
-        let cy = c[ky] - self.sy * c[kz];
+        let (ax, ay) = (a.dot(self.row_x), a.dot(self.row_y));
+        let (bx, by) = (b.dot(self.row_x), b.dot(self.row_y));
+        let (cx, cy) = (c.dot(self.row_x), c.dot(self.row_y));
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
@@ -153,9 +161,7 @@ impl WatertightRay {
         if det == 0.0 {
             return None;
         }
-        let az = self.sz * a[kz];
-        let bz = self.sz * b[kz];
-        let cz = self.sz * c[kz];
+        let (az, bz, cz) = (a.dot(self.row_z), b.dot(self.row_z), c.dot(self.row_z));
         let t_scaled = u * az + v * bz + w * cz;
         let inv_det = 1.0 / det;
         let t = t_scaled * inv_det;
