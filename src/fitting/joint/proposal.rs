@@ -296,20 +296,16 @@ pub(super) fn from_proposal(
     if !traced.made_for(pixels, planes, roi) {
         return None;
     }
-    let stored = (0..planes.len())
-        .map(|k| {
-            reweighted(
-                &traced.stored[k],
-                &traced.recorded.lobes[k],
-                &traced.recorded.rays,
-                &traced.recorded.water,
-                &traced.recorded.drew,
-                planes[k],
-                &rw.target,
-                model,
-            )
-        })
-        .collect();
+    let stored = reweighted(
+        &traced.stored,
+        &traced.recorded.lobes,
+        &traced.recorded.rays,
+        &traced.recorded.water,
+        &traced.recorded.drew,
+        planes,
+        &rw.target,
+        model,
+    );
     Some((stored, traced.per_pixel_samples))
 }
 

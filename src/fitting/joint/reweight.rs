@@ -119,35 +119,65 @@ impl Recorded {
     }
 }
 
-/// The samples of `plane` recorded under a proposal lobe (`base`, `lobes` its samples'
-/// lobes, `rays`, `water` and `drew` per pixel), weighted for the lobe `target` (`model` gives the
-/// IOR and the geometry term; module doc): each sample's weight is the target's `f cos` over the proposal's density,
-/// less the target's control variate, and each pixel's Gaussian is matched to the target.
+/// The samples of every plane of a trace recorded under a proposal lobe (`base` and `lobes`
+/// per plane, its samples and their lobes; `rays`, `water` and `drew` per pixel), weighted
+/// for the lobe `target` (`model` gives the IOR and the geometry term; module doc): each
+/// sample's weight is the target's `f cos` over the proposal's density, less the target's
+/// control variate, and each pixel's Gaussian is matched to the target on each plane. A
+/// pixel's lobe directions under the target are drawn once for all the planes: on the
+/// harbour pair's two planes they were half of a held fit's time when drawn per plane.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn reweighted(
-    base: &PlaneSamples,
-    lobes: &[SampleLobe],
+    base: &[PlaneSamples],
+    lobes: &[Vec<SampleLobe>],
     rays: &[Vec<CameraRay>],
     water: &[Option<WaterPoint>],
     drew: &[f32],
-    plane: &LightPlane,
+    planes: &[&LightPlane],
     target: &Lobe,
     model: &ReflectionModel,
-) -> PlaneSamples {
+) -> Vec<PlaneSamples> {
     let target_model = target.model(model);
-    let pixels = base.offsets.len() - 1;
-    let gauss: Vec<LobeGaussian> = (0..pixels)
+    let pixels = water.len();
+    // Per pixel, its Gaussian on each plane.
+    let per_pixel: Vec<Vec<LobeGaussian>> = (0..pixels)
         .into_par_iter()
         .map(|i| match water[i] {
             Some(w) => {
                 let (dirs, count) = lobe_directions(target.water_model(), &target_model, &w);
-                let mut g = LobeGaussian::matched(plane, w.start, &dirs, count);
-                g.mass *= drew[i];
-                g
+                planes
+                    .iter()
+                    .map(|plane| {
+                        let mut g = LobeGaussian::matched(plane, w.start, &dirs, count);
+                        g.mass *= drew[i];
+                        g
+                    })
+                    .collect()
             }
-            None => LobeGaussian::NONE,
+            None => vec![LobeGaussian::NONE; planes.len()],
         })
         .collect();
+    base.iter()
+        .zip(lobes)
+        .enumerate()
+        .map(|(k, (base, lobes))| {
+            let gauss: Vec<LobeGaussian> = per_pixel.iter().map(|g| g[k]).collect();
+            reweighted_plane(base, lobes, rays, gauss, target, &target_model)
+        })
+        .collect()
+}
+
+/// One plane's samples weighted for `target` (of model `target_model`), its pixels'
+/// Gaussians `gauss` already matched to the target ([`reweighted`]).
+fn reweighted_plane(
+    base: &PlaneSamples,
+    lobes: &[SampleLobe],
+    rays: &[Vec<CameraRay>],
+    gauss: Vec<LobeGaussian>,
+    target: &Lobe,
+    target_model: &ReflectionModel,
+) -> PlaneSamples {
+    let pixels = base.offsets.len() - 1;
     let weights: Vec<f32> = (0..pixels)
         .into_par_iter()
         .flat_map_iter(|i| {
@@ -166,7 +196,7 @@ pub(super) fn reweighted(
                     }
                     let lobe = match rays.get(l.ray as usize) {
                         Some(&(wo, axis)) if l.pdf > 0.0 => {
-                            target.eval_cos(&target_model, axis, wo, l.wi) / l.pdf
+                            target.eval_cos(target_model, axis, wo, l.wi) / l.pdf
                         }
                         _ => 0.0,
                     };
@@ -253,15 +283,16 @@ mod tests {
         fn weighted(&self, traced: &Traced, target: Lobe) -> PlaneSamples {
             let (stored, _, rec) = traced;
             reweighted(
-                &stored[0],
-                &rec.lobes[0],
+                &stored[..1],
+                &rec.lobes[..1],
                 &rec.rays,
                 &rec.water,
                 &rec.drew,
-                &self.t.light.plane,
+                &[&self.t.light.plane],
                 &target,
                 &self.model,
             )
+            .swap_remove(0)
         }
 
         /// The coefficients of `rect` over the pixels: their sum, and the sum of their
@@ -341,6 +372,77 @@ mod tests {
     }
 
     const TARGET: [f32; 2] = [2.6e-3, 2.4e-3];
+
+    /// Planes weighted together come out as each weighted alone: the lobe directions a pixel
+    /// draws once serve every plane, each with its own Gaussians. The second plane is the
+    /// light's face with its origin moved 1 m right and 0.5 m up, so that its samples'
+    /// coordinates and its Gaussians' means differ from the first's.
+    #[test]
+    fn planes_weighted_together_are_each_weighted_alone() {
+        let c = case();
+        let t = &c.t;
+        let plane = &t.light.plane;
+        let shift = plane.u * 1.0 + plane.v * 0.5;
+        let moved = LightPlane {
+            point: plane.point + shift,
+            ..plane.clone()
+        };
+        let moved_roi = Rect {
+            u_min: t.roi.u_min - 1.0,
+            u_max: t.roi.u_max - 1.0,
+            v_min: t.roi.v_min - 0.5,
+            v_max: t.roi.v_max - 0.5,
+        };
+        let planes = [plane, &moved];
+        let proposal = c.waves(TARGET.map(|v| 2.0 * v));
+        let (stored, _, rec) = trace_recorded(
+            proposal.water_model(),
+            &t.scene,
+            &proposal.model(&c.model),
+            &planes,
+            &[t.roi, moved_roi],
+            &t.pixels,
+            (t.width, t.height),
+            (32, 1, 0, 0),
+            true,
+            t.pixels.len(),
+            true,
+            crate::progress::Reporter::default(),
+        );
+        let rec = rec.expect("recorded");
+        let target = c.waves(TARGET);
+        let together = reweighted(
+            &stored, &rec.lobes, &rec.rays, &rec.water, &rec.drew, &planes, &target, &c.model,
+        );
+        assert_eq!(together.len(), 2);
+        for k in 0..2 {
+            let alone = reweighted(
+                &stored[k..=k],
+                &rec.lobes[k..=k],
+                &rec.rays,
+                &rec.water,
+                &rec.drew,
+                &planes[k..=k],
+                &target,
+                &c.model,
+            )
+            .swap_remove(0);
+            assert!(alone.weights.len() > 10_000, "{}", alone.weights.len());
+            assert_eq!(together[k].weights, alone.weights, "plane {k}");
+            assert_eq!(together[k].gauss, alone.gauss, "plane {k}");
+        }
+        // The two planes' Gaussians differ by the shift of the origin.
+        let (a, b) = (&together[0].gauss, &together[1].gauss);
+        let matched = a.iter().zip(b).filter(|(g, _)| !g.is_none()).count();
+        assert!(matched > 1000, "{matched}");
+        for (g0, g1) in a.iter().zip(b).filter(|(g, _)| !g.is_none()) {
+            let d = g0.mean - g1.mean;
+            assert!(
+                (d.x - 1.0).abs() < 1e-3 && (d.y - 0.5).abs() < 1e-3,
+                "{d:?}"
+            );
+        }
+    }
 
     #[test]
     fn weighting_for_the_proposal_itself_changes_nothing() {
