@@ -682,27 +682,80 @@ fn all_pixels_reads_the_whole_region() {
 /// tries each only that way: on the stacked sample from the reflections alone, the one start
 /// light is split one above the other; told so, the fit makes the same lights to the last
 /// bit (the same samples: only the side-by-side trial is left out); told "side by side", it
-/// never cuts the light the other way.
+/// never cuts the light the other way. Each long step of the split says what it does and
+/// counts its work: the ways tried, the new light's own trace, the boundary's candidates.
 #[test]
 fn a_known_split_is_tried_only_its_way() {
     use streaklight::fitting::joint::{Split, SplitWay};
+    use streaklight::progress::{Progress, Reporter};
+    /// A stage, with the counts of work reported under it: (done, total).
+    type Stage = (String, Vec<(u64, u64)>);
+    /// Every stage.
+    #[derive(Default)]
+    struct Record(std::sync::Mutex<Vec<Stage>>);
+    impl Progress for Record {
+        fn stage(&self, line: &str) {
+            self.0.lock().unwrap().push((line.to_string(), Vec::new()));
+        }
+        fn advance(&self, done: u64, total: u64) {
+            if let Some(last) = self.0.lock().unwrap().last_mut() {
+                last.1.push((done, total));
+            }
+        }
+    }
     let start = paper_start("stacked.png");
     assert_eq!(start.paper.lights.len(), 1, "the paper fit makes one light");
-    let fit = |known: &[Split]| {
+    let record = Record::default();
+    let fit = |known: &[Split], progress: Reporter<'_>| {
         start.fit(|o| JointOptions {
             samples: 32,
             direct_view: false,
             known_splits: known,
+            progress,
             ..o
         })
     };
-    let free = fit(&[]);
+    let fit_silently = |known: &[Split]| fit(known, Reporter::default());
+    let free = fit(&[], Reporter::new(&record));
     let stacked = Split {
         light: 0,
         way: SplitWay::Stacked,
     };
     assert_eq!(free.splits, [stacked]);
     assert_eq!(free.lights.len(), 2);
+    let stages = record.0.into_inner().unwrap();
+    // The stage that starts with `prefix`, and its counts.
+    let stage = |prefix: &str| {
+        stages
+            .iter()
+            .find(|(line, _)| line.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no stage {prefix:?} in {stages:#?}"))
+    };
+    // Counted from 0 to the total, in order.
+    let counted = |counts: &[(u64, u64)], total: u64| {
+        counts.first() == Some(&(0, total))
+            && counts.last() == Some(&(total, total))
+            && counts.windows(2).all(|w| w[0].0 <= w[1].0)
+    };
+    let (_, ways) = stage("joint fit: the residual is structured");
+    assert!(counted(ways, 2), "{ways:?}");
+    let (line, traced) = stage("joint fit: the residual of light 0 is structured");
+    assert!(line.contains("one above the other"), "{line}");
+    assert!(
+        counted(traced, traced.last().map_or(0, |c| c.1)),
+        "{traced:?}"
+    );
+    assert!(traced.last().is_some_and(|c| c.1 > 1000), "{traced:?}");
+    stage("joint fit: searching where lights 0 and 1 meet");
+    let (line, candidates) = stage("joint fit: lights 0 and 1: descents from ");
+    let n: u64 = line
+        .trim_start_matches("joint fit: lights 0 and 1: descents from ")
+        .split(' ')
+        .next()
+        .and_then(|n| n.parse().ok())
+        .expect("a count of candidates");
+    assert!(n >= 1 && counted(candidates, n), "{line}: {candidates:?}");
+    let fit = fit_silently;
     let told = fit(&[stacked]);
     assert_eq!(told.splits, free.splits);
     for (a, b) in told.lights.iter().zip(&free.lights) {

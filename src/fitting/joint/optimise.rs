@@ -77,12 +77,19 @@ pub(super) fn optimise(
                 Some(s) => std::slice::from_ref(&s.way),
                 None => &SplitWay::ALL[..],
             };
-            let Some((trial, way, inner)) = try_split(problem, &st, k, extents, ways) else {
+            let Some((trial, way, inner)) = try_split(problem, &st, k, extents, ways, progress)
+            else {
                 continue;
             };
             splits.push(Split { light: k, way });
             st = trial;
             let b = st.rects.len() - 1;
+            progress.stage(&format!(
+                "joint fit: the residual of light {k} is structured, as where two lights' \
+                 reflections merge into one streak: split into lights {k} and {b}, {}; \
+                 tracing light {b}'s own samples",
+                way.words()
+            ));
             // The two lights of a split read independent samples: with one set shared, the
             // cost's noise along their common boundary has minima far from the truth
             // (BENCHMARKS.md, the stacked sample).
@@ -92,11 +99,12 @@ pub(super) fn optimise(
             extents.push(sample_extent(&samples));
             let set = problem.add_set(samples, origin);
             problem.move_to_set(&mut st, b, set);
+            progress.stage(&format!(
+                "joint fit: searching where lights {k} and {b} meet"
+            ));
             let starts = search_boundary(problem, &st, k, b, inner);
             progress.stage(&format!(
-                "joint fit: the residual of light {k} is structured, as where two lights' \
-                 reflections merge into one streak: split into lights {k} and {b}, their \
-                 boundary searched from {} candidates",
+                "joint fit: lights {k} and {b}: descents from {} candidate boundaries",
                 starts.len()
             ));
             let candidates = starts.len() as u64;
@@ -109,6 +117,7 @@ pub(super) fn optimise(
                     best = Some((cand, c));
                 }
             }
+            progress.advance(candidates, candidates);
             if let Some((cand, _)) = best {
                 st = cand;
             }

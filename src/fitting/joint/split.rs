@@ -5,6 +5,7 @@
 use super::problem::{Problem, State};
 use crate::fitting::rect::Rect;
 use crate::fitting::EdgeSide;
+use crate::progress::Reporter;
 
 /// Sweeps of the coarse fit that decides whether splitting a light pays.
 const SPLIT_TRIAL_SWEEPS: u32 = 8;
@@ -28,6 +29,14 @@ pub enum SplitWay {
 impl SplitWay {
     /// Both ways, in the order they are tried.
     pub const ALL: [SplitWay; 2] = [SplitWay::Stacked, SplitWay::SideBySide];
+
+    /// The way in words, for the progress lines.
+    pub fn words(self) -> &'static str {
+        match self {
+            SplitWay::Stacked => "one above the other",
+            SplitWay::SideBySide => "side by side",
+        }
+    }
 }
 
 /// A light that a joint fit explained as two: its index among the fit's start lights, and
@@ -47,17 +56,20 @@ pub struct Split {
 /// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, its way, and the two edges that
 /// face each other (the first light's, then the second's, the new light last in the state).
 /// This only decides whether and which way to split: where the two lights meet is
-/// [`search_boundary`](super::boundary::search_boundary)'s work.
+/// [`search_boundary`](super::boundary::search_boundary)'s work. `progress` hears the count of
+/// ways tried (each a descent of the two halves: about a second on the stacked sample).
 pub(super) fn try_split(
     problem: &Problem,
     st: &State,
     k: usize,
     extents: &[Option<Rect>],
     ways: &[SplitWay],
+    progress: Reporter<'_>,
 ) -> Option<(State, SplitWay, [EdgeSide; 2])> {
     let r = st.rects[k];
     let mut best: Option<(State, SplitWay, [EdgeSide; 2], f64)> = None;
-    for &way in ways {
+    for (done, &way) in ways.iter().enumerate() {
+        progress.advance(done as u64, ways.len() as u64);
         let (first, second, inner) = match way {
             SplitWay::Stacked => (
                 r.with_edge(EdgeSide::Top, 0.5 * (r.v_min + r.v_max)),
@@ -102,6 +114,7 @@ pub(super) fn try_split(
             best = Some((trial, way, inner, c));
         }
     }
+    progress.advance(ways.len() as u64, ways.len() as u64);
     let before = problem.row_cost(st);
     best.filter(|(_, _, _, c)| *c < SPLIT_MIN_ROW_COST_RATIO * before)
         .map(|(trial, way, inner, _)| (trial, way, inner))
