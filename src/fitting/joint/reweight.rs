@@ -124,8 +124,9 @@ impl Recorded {
 /// for the lobe `target` (`model` gives the IOR and the geometry term; module doc): each
 /// sample's weight is the target's `f cos` over the proposal's density, less the target's
 /// control variate, and each pixel's Gaussian is matched to the target on each plane. A
-/// pixel's lobe directions under the target are drawn once for all the planes: on the
-/// harbour pair's two planes they were half of a held fit's time when drawn per plane.
+/// pixel's lobe directions under the target are drawn once for all the planes: they are
+/// the dearest part of the weighting (over the harbour pair's two planes, drawn per plane,
+/// half of a held search fit's time).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn reweighted(
     base: &[PlaneSamples],
