@@ -139,30 +139,34 @@ pub(super) fn reweighted(
     model: &ReflectionModel,
 ) -> Vec<PlaneSamples> {
     let target_model = target.model(model);
-    let pixels = water.len();
-    // Per pixel, its Gaussian on each plane.
-    let per_pixel: Vec<Vec<LobeGaussian>> = (0..pixels)
+    // Pixel by pixel, its Gaussian on each plane in turn.
+    let matched: Vec<LobeGaussian> = (0..water.len())
         .into_par_iter()
-        .map(|i| match water[i] {
-            Some(w) => {
+        .flat_map_iter(|i| {
+            let drawn = water[i].map(|w| {
                 let (dirs, count) = lobe_directions(target.water_model(), &target_model, &w);
-                planes
-                    .iter()
-                    .map(|plane| {
-                        let mut g = LobeGaussian::matched(plane, w.start, &dirs, count);
-                        g.mass *= drew[i];
-                        g
-                    })
-                    .collect()
-            }
-            None => vec![LobeGaussian::NONE; planes.len()],
+                (w, dirs, count)
+            });
+            planes.iter().map(move |plane| match &drawn {
+                Some((w, dirs, count)) => {
+                    let mut g = LobeGaussian::matched(plane, w.start, dirs, *count);
+                    g.mass *= drew[i];
+                    g
+                }
+                None => LobeGaussian::NONE,
+            })
         })
         .collect();
     base.iter()
         .zip(lobes)
         .enumerate()
         .map(|(k, (base, lobes))| {
-            let gauss: Vec<LobeGaussian> = per_pixel.iter().map(|g| g[k]).collect();
+            let gauss = matched
+                .iter()
+                .skip(k)
+                .step_by(planes.len())
+                .copied()
+                .collect();
             reweighted_plane(base, lobes, rays, gauss, target, &target_model)
         })
         .collect()
