@@ -100,6 +100,7 @@ use crate::water_model::{ExactSurface, WaterModel};
 use crate::{Error, Result};
 
 mod boundary;
+mod clipped;
 mod colour;
 mod control_variate;
 mod cost;

@@ -7,6 +7,7 @@
 
 use rayon::prelude::*;
 
+use super::clipped::{one_sided_costs, ClippedConstant, ClippedPixel, ClippedRow};
 use super::control_variate;
 use super::control_variate::LobeGaussian;
 use super::pieces::{PieceSums, Window, CUBIC_NODES};
@@ -72,11 +73,9 @@ struct ProfileSums {
     /// The same at every grid point (pixels with no sample in the window), kept once.
     flat: FlatSums,
     clipped_rows: Vec<ClippedRow>,
+    /// The clipped pixels whose coefficient is the same at every grid point.
+    clipped_flat: Vec<ClippedConstant>,
 }
-
-/// A clipped pixel of an edge profile: its index, its coefficient at every grid point, and
-/// its residual with light k dark (the others' part taken off).
-type ClippedRow = (usize, Vec<f32>, [f64; 3]);
 
 /// Normal-equation sums that do not depend on the edge's grid position.
 #[derive(Default)]
@@ -113,6 +112,7 @@ impl Problem {
         let mut pieces = PieceSums::new(grid);
         // Clipped pixels need the whole c(t) to apply their one-sided residual later.
         let mut clipped_rows: Vec<ClippedRow> = Vec::new();
+        let mut clipped_flat: Vec<ClippedConstant> = Vec::new();
         let mut flat = FlatSums::default();
         let hi = lo + step * (grid - 1) as f32;
         let frame = EdgeFrame::new(&rect, side);
@@ -144,9 +144,15 @@ impl Problem {
             let gauss_varies = !g.is_none()
                 && g_across * control_variate::normal_between(lo, hi, g_mean, g_sd) > 0.0;
             let samples_reach = !(bmax < lo || bmin > hi);
-            // Its coefficient and half-difference, when they are the same at every grid point.
-            let same_everywhere = |c: f64, d: f64, flat: &mut FlatSums| {
-                if c != 0.0 {
+            // Its coefficient and half-difference, when they are the same at every grid point
+            // (a clipped pixel's cost is one-sided, not a normal-equation sum: `clipped`).
+            let mut same_everywhere = |c: f64, d: f64, flat: &mut FlatSums| {
+                if self.clipped[i] {
+                    if c != 0.0 || d != 0.0 {
+                        let pixel = self.clipped_pixel(st, k, i);
+                        clipped_flat.push(ClippedConstant { pixel, c, d });
+                    }
+                } else if c != 0.0 {
                     let (rest, rest_dev) = self.others(st, k, i);
                     flat.a_raw += c * c;
                     flat.a += c * c - d * d;
@@ -155,7 +161,7 @@ impl Problem {
                     }
                 }
             };
-            if !samples_reach && !gauss_varies && !self.clipped[i] {
+            if !samples_reach && !gauss_varies {
                 // Nothing of this pixel's coefficient changes over the window.
                 same_everywhere(st.coef[k][i] as f64, st.dev[k][i] as f64, &mut flat);
                 continue;
@@ -164,7 +170,7 @@ impl Problem {
             let g_now = g.mass_inside(&rect);
             ramps.clear(grid);
             let mut any = false;
-            if !samples_reach && !self.clipped[i] {
+            if !samples_reach {
                 // Only the Gaussian moves: the samples' part is what it is now.
                 let inv = self.inv_samples as f64;
                 let sampled = st.coef[k][i] as f64 - g_now as f64;
@@ -172,7 +178,7 @@ impl Problem {
                 ramps.constant(sampled / inv, dev);
                 any = true;
             }
-            if samples_reach || self.clipped[i] {
+            if samples_reach {
                 // Only the samples near the window (and the edge's place now) move with the
                 // edge: the others count as they do now, which the current coefficient less
                 // the near samples' share gives without reading them (in late sweeps, a
@@ -190,11 +196,11 @@ impl Problem {
                 }
                 any |= touched;
             }
-            if !any && !gauss_varies && !self.clipped[i] {
+            if !any && !gauss_varies {
                 same_everywhere(g_now as f64, 0.0, &mut flat);
                 continue;
             }
-            if !ramps.kinked && !self.clipped[i] && !gauss_varies {
+            if !ramps.kinked && !gauss_varies {
                 // Every kernel it has lies wholly on one side of the window.
                 let [c, d] = ramps.constant;
                 let inv = self.inv_samples as f64;
@@ -250,7 +256,16 @@ impl Problem {
                 }
             }
             if self.clipped[i] {
-                clipped_rows.push((i, cvals.iter().map(|c| c * self.inv_samples).collect(), res));
+                let inv = self.inv_samples;
+                clipped_rows.push(ClippedRow {
+                    pixel: ClippedPixel {
+                        res,
+                        rest_dev,
+                        bound: self.clipped_channels[i],
+                    },
+                    c: cvals.iter().map(|c| c * inv).collect(),
+                    d: half_difference.iter().map(|d| d * inv).collect(),
+                });
                 continue;
             }
             for j in 0..grid {
@@ -273,6 +288,17 @@ impl Problem {
             b,
             flat,
             clipped_rows,
+            clipped_flat,
+        }
+    }
+
+    /// Clipped pixel i's residual and the other lights' half-difference with light k dark.
+    fn clipped_pixel(&self, st: &State, k: usize, i: usize) -> ClippedPixel {
+        let (rest, rest_dev) = self.others(st, k, i);
+        ClippedPixel {
+            res: [0, 1, 2].map(|ch| self.obs[i][ch] as f64 - rest[ch]),
+            rest_dev,
+            bound: self.clipped_channels[i],
         }
     }
 
@@ -299,6 +325,7 @@ impl Problem {
         let mut a_raw = vec![0f64; grid];
         let mut b = vec![[0f64; 3]; grid];
         let mut clipped_rows: Vec<ClippedRow> = Vec::new();
+        let mut clipped_flat: Vec<ClippedConstant> = Vec::new();
         for part in parts {
             for j in 0..grid {
                 a[j] += part.a[j] + part.flat.a;
@@ -308,6 +335,7 @@ impl Problem {
                 }
             }
             clipped_rows.extend(part.clipped_rows);
+            clipped_flat.extend(part.clipped_flat);
         }
         // Pixels with no sample of light k contribute a constant, left out.
         // A rectangle that catches only a few samples has a variance as large as its mean
@@ -316,34 +344,28 @@ impl Problem {
         for j in 0..grid {
             a[j] = a[j].max(0.5 * a_raw[j]);
         }
-        (0..grid)
-            .into_par_iter()
+        let radiance: Vec<[f64; 3]> = (0..grid)
             .map(|j| {
-                let l = [0, 1, 2].map(|ch| {
+                [0, 1, 2].map(|ch| {
                     if a[j] > 0.0 {
                         (b[j][ch] / a[j]).max(0.0)
                     } else {
                         0.0
                     }
-                });
+                })
+            })
+            .collect();
+        let clipped = one_sided_costs(&clipped_flat, &clipped_rows, &radiance);
+        radiance
+            .into_iter()
+            .zip(clipped)
+            .enumerate()
+            .map(|(j, (l, clipped))| {
                 // sum (r - L c)^2 - sum r^2 = L^2 A - 2 L B
-                let mut cost: f64 = (0..3)
+                let cost: f64 = (0..3)
                     .map(|ch| l[ch] * l[ch] * a[j] - 2.0 * l[ch] * b[j][ch])
-                    .sum();
-                for (i, cs, res) in &clipped_rows {
-                    let c = cs[j] as f64;
-                    for ch in 0..3 {
-                        let r0 = res[ch];
-                        let r = r0 - l[ch] * c;
-                        // A clipped channel is a lower bound; the pixel's other channels
-                        // are values.
-                        let bound = self.clipped_channels[*i][ch];
-                        let now = if bound && r < 0.0 { 0.0 } else { r * r };
-                        let before = if bound && r0 < 0.0 { 0.0 } else { r0 * r0 };
-                        cost += now - before;
-                    }
-                }
-                (cost, l)
+                    .sum::<f64>();
+                (cost + clipped, l)
             })
             .collect()
     }
@@ -352,6 +374,8 @@ impl Problem {
 #[cfg(test)]
 mod tests {
     use super::super::fixture::table3_light0;
+    use super::super::problem::Problem;
+    use crate::fitting::rect::Rect;
     use crate::fitting::EdgeSide;
 
     #[test]
@@ -360,12 +384,31 @@ mod tests {
         // on every side. At every grid point of every edge, over a wide window and a narrow
         // one, the profile (which reads only the samples near the window) must give the
         // radiance the normal equation of the whole coefficients gives there, and the cost
-        // differences the whole cost gives.
+        // differences the whole cost gives. Then again with the brightest pixels clipped in
+        // their first channel (the radiance is then solved without them, and they count only
+        // while the model is below them).
         let t = table3_light0();
         let (planes, n) = t.trace(72, 1, 0, true);
         let truth = t.light.rect();
         let problem = t.problem(planes, 1.0 / n as f32, &truth);
-        let start = crate::fitting::rect::Rect {
+        the_profile_is_the_cost(&problem, &truth);
+        let mut problem = problem;
+        let top = problem.obs.iter().fold(0f32, |m, o| m.max(o[0]));
+        let mut clipped = 0;
+        for i in 0..problem.n() {
+            if problem.obs[i][0] > 0.5 * top {
+                problem.obs[i][0] = 0.5 * top;
+                problem.clipped[i] = true;
+                problem.clipped_channels[i] = [true, false, false];
+                clipped += 1;
+            }
+        }
+        assert!(clipped > 20, "{clipped} pixels clipped");
+        the_profile_is_the_cost(&problem, &truth);
+    }
+
+    fn the_profile_is_the_cost(problem: &Problem, truth: &Rect) {
+        let start = Rect {
             u_min: truth.u_min + 0.3,
             u_max: truth.u_max - 0.3,
             v_min: truth.v_min - 0.3,
@@ -380,11 +423,11 @@ mod tests {
                 let mut costs = Vec::new();
                 for (j, (_, l)) in profile.iter().enumerate() {
                     let rect = start.with_edge(side, lo + j as f32 * step);
-                    let at = problem.state(vec![0], vec![[false; 4]], vec![rect], vec![*l]);
+                    let mut at = problem.state(vec![0], vec![[false; 4]], vec![rect], vec![*l]);
                     // The radiance of the whole coefficients' normal equation (noise
-                    // removed, as the profile does it).
+                    // removed, as the profile does it), over the pixels not clipped.
                     let (mut a, mut b) = (0f64, [0f64; 3]);
-                    for i in 0..problem.n() {
+                    for i in (0..problem.n()).filter(|&i| !problem.clipped[i]) {
                         let (c, d) = (at.coef[0][i] as f64, at.dev[0][i] as f64);
                         a += c * c - d * d;
                         for (b, o) in b.iter_mut().zip(problem.obs[i]) {
@@ -399,6 +442,7 @@ mod tests {
                             l[ch]
                         );
                     }
+                    at.radiance = vec![*l];
                     costs.push(problem.cost(&at));
                 }
                 let scale = costs.iter().fold(0f64, |m, c| m.max(c.abs()));
