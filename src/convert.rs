@@ -266,6 +266,8 @@ pub fn convert_loaded(
     options: &ConvertOptions,
 ) -> Result<ConvertOutcome> {
     let progress = options.progress;
+    // The output's copies of the scene's files go to disk while the fit runs.
+    let ahead = scene_out::CopiesAhead::start(&options.scene, &options.output, options.input_files);
     let (resolved, exposure_source) = exposure_of(options)?;
     let options = &resolved;
     let photo = timed(&mut before, progress, "load photo", || {
@@ -313,7 +315,7 @@ pub fn convert_loaded(
         .map(|(i, l)| light_to_write(scene, l, light_name(i)))
         .collect();
     let summary = timed(&mut after, progress, "write scene", || {
-        scene_out::write_lit_scene(
+        scene_out::write_lit_scene_with(
             &options.scene,
             &options.output,
             &to_write,
@@ -323,6 +325,7 @@ pub fn convert_loaded(
                 light_offset: options.light_offset,
                 input_files: options.input_files,
             },
+            Some(ahead),
         )
     })?;
     lit.warnings

@@ -17,7 +17,10 @@ use common::scene_out_case::{generated_inputs, triangle_bytes, two_lights};
 use common::scene_out_checks::{assert_self_contained, check_output};
 use common::validator::{assert_validator_clean, validator_problems};
 use serde_json::{json, Value};
-use streaklight::scene_out::{write_lit_scene, InputFiles, NewData, ResourceKind, WriteOptions};
+use streaklight::scene_out::{
+    write_lit_scene, write_lit_scene_with, CopiesAhead, InputFiles, NewData, ResourceKind,
+    WriteOptions,
+};
 
 #[test]
 fn new_data_goes_where_the_table_says() {
@@ -474,6 +477,76 @@ fn a_failed_scene_write_leaves_no_stray_bin() {
         .filter(|e| e.file_name().to_string_lossy().contains("tmp-streaklight"))
         .collect();
     assert!(leftovers.is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn copies_written_ahead_are_the_files_written_at_the_end() {
+    // Every input kind written as a .gltf (copies beside it), once at the end and once with
+    // its copies written ahead: the same files, byte for byte, and no temporary left. A
+    // start never finished removes what it wrote; a start whose copy would land on an input
+    // is refused at the end as without it, the input untouched.
+    let dir = temp_dir("ahead");
+    let inputs = generated_inputs(&dir);
+    let lights = two_lights();
+    let opts = WriteOptions::default();
+    let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
+        let mut all: Vec<(String, Vec<u8>)> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| {
+                let e = e.unwrap();
+                // A folder by its name alone.
+                let bytes = if e.path().is_dir() {
+                    Vec::new()
+                } else {
+                    std::fs::read(e.path()).unwrap()
+                };
+                (e.file_name().to_string_lossy().into_owned(), bytes)
+            })
+            .collect();
+        all.sort();
+        all
+    };
+    let mut copied = 0;
+    for (k, input) in inputs.iter().enumerate() {
+        let (end, ahead) = (dir.join(format!("end{k}")), dir.join(format!("ahead{k}")));
+        std::fs::create_dir_all(&end).unwrap();
+        std::fs::create_dir_all(&ahead).unwrap();
+        let at_end = write_lit_scene(input, &end.join("out.gltf"), &lights, &opts).unwrap();
+        let out = ahead.join("out.gltf");
+        let started = CopiesAhead::start(input, &out, InputFiles::Copy);
+        let with = write_lit_scene_with(input, &out, &lights, &opts, Some(started)).unwrap();
+        assert_eq!(files(&end), files(&ahead), "{}", input.display());
+        assert_eq!(
+            with.resources.files_written.len(),
+            at_end.resources.files_written.len()
+        );
+        copied += with.resources.copied.len();
+        // Started and dropped: nothing stays.
+        let dropped = dir.join(format!("dropped{k}"));
+        std::fs::create_dir_all(&dropped).unwrap();
+        drop(CopiesAhead::start(
+            input,
+            &dropped.join("out.gltf"),
+            InputFiles::Copy,
+        ));
+        assert!(files(&dropped).is_empty(), "{:?}", files(&dropped));
+    }
+    assert!(copied >= 2, "the inputs' copies: {copied}");
+    // The external input beside its output, its buffer named as the output's copy of it.
+    let src = &inputs[0];
+    let folder = src.parent().unwrap();
+    std::fs::copy(folder.join("geometry.bin"), folder.join("lit.buffer0.bin")).unwrap();
+    let text = std::fs::read_to_string(src).unwrap();
+    let renamed = folder.join("renamed.gltf");
+    std::fs::write(&renamed, text.replace("geometry.bin", "lit.buffer0.bin")).unwrap();
+    let before = files(folder);
+    let out = folder.join("lit.gltf");
+    let started = CopiesAhead::start(&renamed, &out, InputFiles::Copy);
+    let err = write_lit_scene_with(&renamed, &out, &lights, &opts, Some(started))
+        .expect_err("the copy would overwrite an input");
+    assert!(err.to_string().contains("lit.buffer0.bin"), "{err}");
+    assert_eq!(files(folder), before);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

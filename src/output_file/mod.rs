@@ -182,6 +182,13 @@ pub fn write_atomically_last(path: &Path, bytes: &[u8]) -> Result<()> {
 fn write(path: &Path, bytes: &[u8], last: bool) -> Result<()> {
     ensure_folder_exists(path)?;
     run::check_target(path)?;
+    let temp = write_temporary(path, bytes)?;
+    place(path, temp, last)
+}
+
+/// `bytes` in a new temporary file beside `path` (created exclusively under an unpredictable
+/// name, registered for the interrupt handler), flushed to disk. A failure leaves no file.
+fn write_temporary(path: &Path, bytes: &[u8]) -> Result<tempfile::TempPath> {
     let name = path
         .file_name()
         .ok_or_else(|| Error::output(path, "the output path names no file"))?;
@@ -210,23 +217,74 @@ fn write(path: &Path, bytes: &[u8], last: bool) -> Result<()> {
         temp.as_file().sync_all()?;
         Ok(temp.into_temp_path())
     })();
-    let temp = match written {
-        Ok(t) => t,
-        Err(e) => {
-            // The temporary was dropped, and so removed, inside the closure.
-            interrupt::forget(&mut interrupt::live(), &temp_path);
-            return Err(Error::io(path, e));
-        }
-    };
+    written.map_err(|e| {
+        // The temporary was dropped, and so removed, inside the closure.
+        interrupt::forget(&mut interrupt::live(), &temp_path);
+        Error::io(path, e)
+    })
+}
+
+/// Puts a written temporary in place as `path`: in the open run, at its commit; else now.
+fn place(path: &Path, temp: tempfile::TempPath, last: bool) -> Result<()> {
     if run::is_open() {
         run::add_pending(path, temp, last);
         test_pause();
         return Ok(());
     }
+    let temp_path = temp.to_path_buf();
     let mut live = interrupt::live();
     let result = temp.persist(path);
     interrupt::forget(&mut live, &temp_path);
     result.map_err(|e| Error::io(path, e.error))
+}
+
+/// A file written ahead of its place: its bytes in a temporary beside it, flushed to disk, so
+/// that a long run's large outputs that do not depend on its result (the copies of a scene's
+/// buffers) reach the disk while it works. [`WrittenAhead::place`] puts it in place as
+/// [`write_atomically`] would; dropped instead, the temporary is removed.
+pub struct WrittenAhead {
+    path: std::path::PathBuf,
+    temp: Option<tempfile::TempPath>,
+}
+
+impl WrittenAhead {
+    /// Writes `bytes` for `path`, whose folder must exist already (on any thread: no run is
+    /// consulted until [`Self::place`]).
+    pub fn write(path: &Path, bytes: &[u8]) -> Result<Self> {
+        if !folder_of(path).is_dir() {
+            return Err(Error::output(path, "its folder does not exist yet"));
+        }
+        Ok(WrittenAhead {
+            path: path.to_path_buf(),
+            temp: Some(write_temporary(path, bytes)?),
+        })
+    }
+
+    /// The file it will be.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Puts the file in place as [`write_atomically`] would (checked against the open run's
+    /// inputs and outputs, renamed at its commit).
+    pub fn place(mut self) -> Result<()> {
+        run::check_target(&self.path)?;
+        match self.temp.take() {
+            Some(temp) => place(&self.path, temp, false),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for WrittenAhead {
+    fn drop(&mut self) {
+        if let Some(temp) = self.temp.take() {
+            let temp_path = temp.to_path_buf();
+            let mut live = interrupt::live();
+            drop(temp);
+            interrupt::forget(&mut live, &temp_path);
+        }
+    }
 }
 
 #[cfg(test)]

@@ -13,6 +13,7 @@
 //! buffers merge into buffer 0 and images become buffer views; for a `.gltf`, URIs name the
 //! copies. Every value read through them is the same.
 
+mod ahead;
 mod document;
 mod edit;
 mod embed;
@@ -31,6 +32,7 @@ use serde_json::{json, Value};
 use crate::{Error, Result};
 use edit::{array_mut, len_of, object_mut, push, root_mut, use_extension};
 
+pub use ahead::CopiesAhead;
 pub use lights::EXTENSION;
 pub use restore::{restore_lights, RestoreSummary};
 
@@ -233,6 +235,19 @@ pub fn write_lit_scene(
     lights: &[LightToWrite],
     options: &WriteOptions,
 ) -> Result<WriteSummary> {
+    write_lit_scene_with(input, output, lights, options, None)
+}
+
+/// [`write_lit_scene`], with the output's copies of the input's files written ahead
+/// ([`CopiesAhead::start`] with the same `input`, `output` and `options.input_files`), put
+/// in place instead of written again.
+pub fn write_lit_scene_with(
+    input: &Path,
+    output: &Path,
+    lights: &[LightToWrite],
+    options: &WriteOptions,
+    ahead: Option<CopiesAhead>,
+) -> Result<WriteSummary> {
     document::Format::from_output_path(output)?;
     if !(options.nits_scale.is_finite() && options.nits_scale > 0.0) {
         return Err(Error::Usage(format!(
@@ -251,7 +266,13 @@ pub fn write_lit_scene(
         .enumerate()
         .map(|(i, l)| lights::prepare(l, i, options.nits_scale, options.light_offset))
         .collect::<Result<Vec<_>>>()?;
-    let mut staged = staged::stage(input, output, options.input_files)?;
+    let (mut staged, written) = match ahead.and_then(CopiesAhead::finish) {
+        Some(ahead) => (ahead.staged, ahead.written),
+        None => (
+            staged::stage(input, output, options.input_files)?,
+            Vec::new(),
+        ),
+    };
     let mut summary = WriteSummary {
         light_indices: Vec::new(),
         node_indices: Vec::new(),
@@ -270,7 +291,7 @@ pub fn write_lit_scene(
         let root = root_mut(&mut staged.json, input)?;
         append_lights(root, &prepared, &mut summary, input)?;
     }
-    summary.resources = staged.write(output)?;
+    summary.resources = staged.write(output, written)?;
     Ok(summary)
 }
 

@@ -133,7 +133,7 @@ pub fn restore_lights(input: &Path, output: &Path, files: InputFiles) -> Result<
     if !summary.restored_nodes.is_empty() {
         use_extension(root, EXTENSION, input)?;
     }
-    summary.resources = staged.write(output)?;
+    summary.resources = staged.write(output, Vec::new())?;
     Ok(summary)
 }
 

@@ -18,7 +18,7 @@ use super::document::{self, padded_len, Document, Format};
 use super::edit::{len_of, push, root_mut};
 use super::side_files::{self, SideFile};
 use super::{embed, resources, InputFiles, NewData, ResourceHandling};
-use crate::output_file::{self, ensure_not_an_input};
+use crate::output_file::{self, ensure_not_an_input, WrittenAhead};
 use crate::{Error, Result};
 
 /// See the module docs.
@@ -196,10 +196,17 @@ impl Staged {
         Ok((buffer, offset))
     }
 
+    /// Takes out the copies of the input's files, to be written ahead
+    /// ([`super::CopiesAhead`]).
+    pub(super) fn take_side(&mut self) -> Vec<SideFile> {
+        std::mem::take(&mut self.side)
+    }
+
     /// Writes the files beside the output, then the output, all together
-    /// ([`output_file::Run`]: the output is renamed into place last); checks first that none of
-    /// them is an input or another. If a write fails, nothing is left written.
-    pub fn write(mut self, output: &Path) -> Result<ResourceHandling> {
+    /// ([`output_file::Run`]: the output is renamed into place last), the files `ahead`
+    /// wrote put in place with them; checks first that none of them is an input or another.
+    /// If a write fails, nothing is left written.
+    pub fn write(mut self, output: &Path, ahead: Vec<WrittenAhead>) -> Result<ResourceHandling> {
         let mut files = std::mem::take(&mut self.side);
         if let Some(bin) = self.moved_bin0.take() {
             files.push((self.data_path.clone(), bin));
@@ -215,12 +222,21 @@ impl Staged {
         };
         files.push((output.to_path_buf(), out_bytes));
         let inputs: Vec<&Path> = self.inputs.iter().map(PathBuf::as_path).collect();
-        for (path, _) in &files {
+        let paths: Vec<&Path> = ahead
+            .iter()
+            .map(WrittenAhead::path)
+            .chain(files.iter().map(|(p, _)| p.as_path()))
+            .collect();
+        for path in &paths {
             ensure_not_an_input(path, &inputs)?;
         }
-        output_file::ensure_distinct(&files.iter().map(|(p, _)| p.as_path()).collect::<Vec<_>>())?;
+        output_file::ensure_distinct(&paths)?;
+        let written_ahead: Vec<PathBuf> = ahead.iter().map(|w| w.path().to_path_buf()).collect();
         // All together or nothing: in the caller's run if it opened one, else in our own.
         let run = output_file::Run::begin();
+        for written in ahead {
+            written.place()?;
+        }
         let count = files.len();
         for (k, (path, bytes)) in files.iter().enumerate() {
             if k + 1 == count {
@@ -232,7 +248,10 @@ impl Staged {
         if run.owns() {
             run.commit()?;
         }
-        self.handling.files_written = files.into_iter().map(|(p, _)| p).collect();
+        self.handling.files_written = written_ahead
+            .into_iter()
+            .chain(files.into_iter().map(|(p, _)| p))
+            .collect();
         Ok(self.handling)
     }
 }
