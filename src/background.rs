@@ -10,6 +10,8 @@
 //! each pixel reads its region's cells bilinearly. The median ignores what little of a streak's faint
 //! tail is left in a cell, so a black night measures black.
 
+use rayon::prelude::*;
+
 use crate::fitting::FittedLight;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
@@ -159,10 +161,11 @@ fn measure(
     photo: &Photo,
     water: &[bool],
     streak: &[bool],
-    level: impl Fn(usize) -> f32,
+    level: impl Fn(usize) -> f32 + Sync,
 ) -> (Vec<[f32; 3]>, usize, usize) {
     let (w, h) = (photo.width as usize, photo.height as usize);
     let lit: Vec<bool> = (0..w * h)
+        .into_par_iter()
         .map(|i| streak[i] || photo.clipped[i] || luminance(photo.radiance[i]) > BRIGHT * level(i))
         .collect();
     let excluded = dilate(&lit, w, h, margin(photo.width, photo.height));
@@ -170,11 +173,13 @@ fn measure(
     let (cw, ch) = (w.div_ceil(side), h.div_ceil(side));
     // Region 0 is the water, 1 the rest.
     let mut grids = [CellGrid::new(cw, ch), CellGrid::new(cw, ch)];
-    let mut cells = 0;
-    for cy in 0..ch {
-        for cx in 0..cw {
-            for (region, grid) in grids.iter_mut().enumerate() {
-                let on_water = region == 0;
+    // Per cell (row by row) and region: whether it holds any of the region's pixels, and
+    // its median when enough of them are kept.
+    let measured: Vec<[(bool, Option<[f32; 3]>); 2]> = (0..cw * ch)
+        .into_par_iter()
+        .map(|cell| {
+            let (cx, cy) = (cell % cw, cell / cw);
+            [true, false].map(|on_water| {
                 let mut total = 0usize;
                 let mut kept: Vec<[f32; 3]> = Vec::new();
                 for y in cy * side..((cy + 1) * side).min(h) {
@@ -189,14 +194,19 @@ fn measure(
                         }
                     }
                 }
-                if total == 0 {
-                    continue;
-                }
+                let value =
+                    (kept.len() >= 16 && 2 * kept.len() >= total).then(|| median(&mut kept));
+                (total > 0, value)
+            })
+        })
+        .collect();
+    let mut cells = 0;
+    for (cell, regions) in measured.into_iter().enumerate() {
+        for (grid, (present, value)) in grids.iter_mut().zip(regions) {
+            if present {
                 cells += 1;
-                grid.present[cy * cw + cx] = true;
-                if kept.len() >= 16 && 2 * kept.len() >= total {
-                    grid.value[cy * cw + cx] = Some(median(&mut kept));
-                }
+                grid.present[cell] = true;
+                grid.value[cell] = value;
             }
         }
     }
@@ -208,6 +218,7 @@ fn measure(
         grid.fill();
     }
     let pixels = (0..w * h)
+        .into_par_iter()
         .map(|i| grids[usize::from(!water[i])].at((i % w) as f32, (i / w) as f32, side as f32))
         .collect();
     (pixels, cells_measured, cells)
@@ -251,29 +262,32 @@ fn median(values: &mut [[f32; 3]]) -> [f32; 3] {
 /// `mask` grown by `r` pixels in each direction (a square), by prefix sums along the rows
 /// and then the columns.
 fn dilate(mask: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
-    let pass = |src: &[bool], along_rows: bool| -> Vec<bool> {
-        let (lines, len) = if along_rows { (h, w) } else { (w, h) };
-        let at = |line: usize, k: usize| {
-            if along_rows {
-                line * w + k
-            } else {
-                k * w + line
-            }
-        };
-        let mut out = vec![false; w * h];
+    // One line (a row, or a column as `len` values `stride` apart from `first`) of `src`,
+    // grown along itself.
+    let line = |src: &[bool], first: usize, stride: usize, len: usize| -> Vec<bool> {
         let mut prefix = vec![0u32; len + 1];
-        for line in 0..lines {
-            for k in 0..len {
-                prefix[k + 1] = prefix[k] + src[at(line, k)] as u32;
-            }
-            for k in 0..len {
-                let (a, b) = (k.saturating_sub(r), (k + r + 1).min(len));
-                out[at(line, k)] = prefix[b] > prefix[a];
-            }
+        for k in 0..len {
+            prefix[k + 1] = prefix[k] + src[first + k * stride] as u32;
         }
-        out
+        (0..len)
+            .map(|k| prefix[(k + r + 1).min(len)] > prefix[k.saturating_sub(r)])
+            .collect()
     };
-    pass(&pass(mask, true), false)
+    let rows: Vec<bool> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| line(mask, y * w, 1, w))
+        .collect();
+    let columns: Vec<Vec<bool>> = (0..w)
+        .into_par_iter()
+        .map(|x| line(&rows, x, w, h))
+        .collect();
+    let mut out = vec![false; w * h];
+    for (x, column) in columns.iter().enumerate() {
+        for (y, &v) in column.iter().enumerate() {
+            out[y * w + x] = v;
+        }
+    }
+    out
 }
 
 /// One region's cells: which hold its pixels, and their measured or filled values.

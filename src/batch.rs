@@ -5,7 +5,10 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::convert::{check_output, convert_loaded, refusing, ConvertOptions, ConvertOutcome};
+use crate::convert::{
+    check_output, convert_loaded, convert_loaded_with, copies_ahead, refusing, ConvertOptions,
+    ConvertOutcome,
+};
 use crate::{output_file, scene_in, Error, Result};
 
 /// One photo of a batch and the files its fit writes.
@@ -63,6 +66,13 @@ pub fn convert_all(template: &ConvertOptions, jobs: &[Job]) -> Result<Vec<Result
     // written over, and each photo's outputs are committed together or not at all.
     let _run = output_file::Run::begin();
     let progress = template.progress;
+    // The first photo's output copies the scene's files while the scene loads, on the core
+    // the load leaves free; the others start with their own fits.
+    let mut first_ahead = options
+        .iter()
+        .zip(&checked)
+        .find(|(_, c)| c.is_ok())
+        .map(|(o, _)| (o.output.clone(), copies_ahead(o)));
     let start = Instant::now();
     progress.stage("load scene");
     let loaded = template
@@ -91,8 +101,13 @@ pub fn convert_all(template: &ConvertOptions, jobs: &[Job]) -> Result<Vec<Result
         .map(|(i, (o, c))| {
             c?;
             progress.stage(&format!("photo {} of {n}: {}", i + 1, o.photo.display()));
-            refusing(o, || {
-                convert_loaded(&scene, vec![("load scene".into(), seconds)], o)
+            let before = vec![("load scene".into(), seconds)];
+            let ahead = first_ahead
+                .take_if(|(output, _)| *output == o.output)
+                .map(|(_, ahead)| ahead);
+            refusing(o, || match ahead {
+                Some(ahead) => convert_loaded_with(&scene, before, o, ahead),
+                None => convert_loaded(&scene, before, o),
             })
         })
         .collect())

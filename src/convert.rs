@@ -221,11 +221,13 @@ pub fn convert(options: &ConvertOptions) -> Result<ConvertOutcome> {
     check_output(options)?;
     refusing(options, || {
         options.fit.validate()?;
+        // Started before the scene's load, which leaves a core free.
+        let ahead = copies_ahead(options);
         let mut before = Vec::new();
         let scene = timed(&mut before, options.progress, "load scene", || {
             scene_in::load(&options.scene, &options.load)
         })?;
-        convert_loaded(&scene, before, options)
+        convert_loaded_with(&scene, before, options, ahead)
     })
 }
 
@@ -262,12 +264,26 @@ fn files(options: &ConvertOptions, output: Option<&Path>) -> Files {
 /// output paths must have been checked ([`check_output`]).
 pub fn convert_loaded(
     scene: &Scene,
-    mut before: Vec<(String, f64)>,
+    before: Vec<(String, f64)>,
     options: &ConvertOptions,
 ) -> Result<ConvertOutcome> {
+    convert_loaded_with(scene, before, options, copies_ahead(options))
+}
+
+/// The output's copies of the scene's files, to be written while the fit runs
+/// ([`scene_out::CopiesAhead`]).
+pub fn copies_ahead(options: &ConvertOptions) -> scene_out::CopiesAhead {
+    scene_out::CopiesAhead::start(&options.scene, &options.output, options.input_files)
+}
+
+/// [`convert_loaded`], the output's copies started already (`ahead`, [`copies_ahead`]).
+pub fn convert_loaded_with(
+    scene: &Scene,
+    mut before: Vec<(String, f64)>,
+    options: &ConvertOptions,
+    ahead: scene_out::CopiesAhead,
+) -> Result<ConvertOutcome> {
     let progress = options.progress;
-    // The output's copies of the scene's files go to disk while the fit runs.
-    let ahead = scene_out::CopiesAhead::start(&options.scene, &options.output, options.input_files);
     let (resolved, exposure_source) = exposure_of(options)?;
     let options = &resolved;
     let photo = timed(&mut before, progress, "load photo", || {
