@@ -10,6 +10,8 @@
 //! pixel next to a narrow glint above t, and such a seed is dropped when the pixel itself is
 //! dimmer than both t and its superpixel.
 
+use rayon::prelude::*;
+
 use crate::{Error, Result};
 
 /// Settings of the seed search.
@@ -108,27 +110,28 @@ fn gaussian_blur(plane: &mut [f32], w: usize, h: usize, sigma: f32) {
         .collect();
     let total: f32 = kernel.iter().sum();
     kernel.iter_mut().for_each(|k| *k /= total);
+    // Row by row in parallel, each pixel's sum in the same order as one pass would take it.
     let mut tmp = vec![0.0f32; plane.len()];
-    for y in 0..h {
-        for x in 0..w {
+    tmp.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, out) in row.iter_mut().enumerate() {
             let mut s = 0.0;
             for (j, k) in kernel.iter().enumerate() {
                 let xx = (x as i64 + j as i64 - radius).clamp(0, w as i64 - 1) as usize;
                 s += k * plane[y * w + xx];
             }
-            tmp[y * w + x] = s;
+            *out = s;
         }
-    }
-    for y in 0..h {
-        for x in 0..w {
+    });
+    plane.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, out) in row.iter_mut().enumerate() {
             let mut s = 0.0;
             for (j, k) in kernel.iter().enumerate() {
                 let yy = (y as i64 + j as i64 - radius).clamp(0, h as i64 - 1) as usize;
                 s += k * tmp[yy * w + x];
             }
-            plane[y * w + x] = s;
+            *out = s;
         }
-    }
+    });
 }
 
 /// Finds the seed points: on every k-th row, the peaks of the mean-filtered V over the water

@@ -12,6 +12,8 @@
 //! `c^2`) at the run's ends as differences, and one pass along the sorted radiances
 //! evaluates `sum r0^2 - 2 L sum r0 c + L^2 sum c^2` at every grid point.
 
+use rayon::prelude::*;
+
 /// A clipped pixel of an edge profile: per channel, its residual `r0` and the other lights'
 /// combined half-difference `rd` (see the note on the coefficients' noise in
 /// [`super::cost`]) when light k is dark, and which channels the photo clipped (the others
@@ -82,6 +84,9 @@ pub(super) fn one_sided_costs(
     cost
 }
 
+/// Clipped pixels per parallel piece of [`add_constant_costs`].
+const CHUNK: usize = 4096;
+
 /// Adds to `cost` the `constant` pixels' cost in channel `ch` at every grid point, whose
 /// radiance in that channel is `radiance` (see the module doc).
 fn add_constant_costs(constant: &[ClippedConstant], ch: usize, radiance: &[f64], cost: &mut [f64]) {
@@ -89,11 +94,39 @@ fn add_constant_costs(constant: &[ClippedConstant], ch: usize, radiance: &[f64],
     let mut order: Vec<usize> = (0..grid).collect();
     order.sort_by(|&a, &b| radiance[a].total_cmp(&radiance[b]));
     let sorted: Vec<f64> = order.iter().map(|&j| radiance[j]).collect();
-    // `steps[m]`: what the sums gain from sorted position m on (one past the end: unused).
-    let mut steps = vec![[0f64; 3]; grid + 1];
-    // The cost with light k dark, taken off at every grid point.
+    // Fixed chunks summed in order: the same sums whatever the thread count.
+    let parts: Vec<(Vec<[f64; 3]>, f64)> = constant
+        .par_chunks(CHUNK)
+        .map(|chunk| steps(chunk, ch, &sorted))
+        .collect();
+    let mut total = vec![[0f64; 3]; grid + 1];
     let mut dark = 0f64;
-    for &ClippedConstant { pixel, c, d } in constant {
+    for (part, part_dark) in parts {
+        for (t, p) in total.iter_mut().zip(part) {
+            for s in 0..3 {
+                t[s] += p[s];
+            }
+        }
+        dark += part_dark;
+    }
+    let mut sums = [0f64; 3];
+    for (m, &j) in order.iter().enumerate() {
+        for s in 0..3 {
+            sums[s] += total[m][s];
+        }
+        let l = sorted[m];
+        cost[j] += sums[0] - 2.0 * l * sums[1] + l * l * sums[2] - dark;
+    }
+}
+
+/// The `pixels`' sums in channel `ch` as steps along the grid's radiances `sorted` (at
+/// `steps[m]`, what the sums gain from sorted position m on; one past the end unused), and
+/// their cost with light k dark.
+fn steps(pixels: &[ClippedConstant], ch: usize, sorted: &[f64]) -> (Vec<[f64; 3]>, f64) {
+    let grid = sorted.len();
+    let mut steps = vec![[0f64; 3]; grid + 1];
+    let mut dark = 0f64;
+    for &ClippedConstant { pixel, c, d } in pixels {
         let (r0, rd) = (pixel.res[ch], pixel.rest_dev[ch]);
         if c == 0.0 && d == 0.0 {
             // The cost is the same with and without light k.
@@ -128,14 +161,7 @@ fn add_constant_costs(constant: &[ClippedConstant], ch: usize, radiance: &[f64],
             steps[run.end][s] -= sums[s];
         }
     }
-    let mut sums = [0f64; 3];
-    for (m, &j) in order.iter().enumerate() {
-        for s in 0..3 {
-            sums[s] += steps[m][s];
-        }
-        let l = sorted[m];
-        cost[j] += sums[0] - 2.0 * l * sums[1] + l * l * sums[2] - dark;
-    }
+    (steps, dark)
 }
 
 #[cfg(test)]
@@ -146,10 +172,11 @@ mod tests {
     fn gathered_costs_are_the_pixels_counted_one_by_one() {
         // Pixels with positive, negative and zero coefficients, residuals of both signs,
         // channels clipped and not; grid radiances unsorted, repeated and crossing many of
-        // the pixels' thresholds r0 / c. Gathered, their costs must be the pixels' own
-        // (`ClippedPixel::cost`, the cost's own rule) summed at every grid point.
+        // the pixels' thresholds r0 / c; more pixels than one parallel piece takes. Gathered,
+        // their costs must be the pixels' own (`ClippedPixel::cost`, the cost's own rule)
+        // summed at every grid point.
         let mut rng = crate::random::Rng::new(7, 0);
-        let constant: Vec<ClippedConstant> = (0..500)
+        let constant: Vec<ClippedConstant> = (0..2 * CHUNK + 500)
             .map(|n| {
                 let c = match n % 7 {
                     0 => 0.0,

@@ -143,7 +143,15 @@ impl Problem {
             };
             let gauss_varies = !g.is_none()
                 && g_across * control_variate::normal_between(lo, hi, g_mean, g_sd) > 0.0;
-            let samples_reach = !(bmax < lo || bmin > hi);
+            // Whether any of its samples' kernels can be inside the rectangle as the edge
+            // moves over the window: reaching into the window, and across it into the
+            // rectangle's extent along the edge (a kernel outside that counts nowhere).
+            let (cmin, cmax) = if along_u {
+                (bb.v_min, bb.v_max)
+            } else {
+                (bb.u_min, bb.u_max)
+            };
+            let samples_reach = !(bmax < lo || bmin > hi || cmax < o_lo || cmin > o_hi);
             // Its coefficient and half-difference, when they are the same at every grid point
             // (a clipped pixel's cost is one-sided, not a normal-equation sum: `clipped`).
             let mut same_everywhere = |c: f64, d: f64, flat: &mut FlatSums| {
