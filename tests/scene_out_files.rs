@@ -533,6 +533,22 @@ fn copies_written_ahead_are_the_files_written_at_the_end() {
         assert!(files(&dropped).is_empty(), "{:?}", files(&dropped));
     }
     assert!(copied >= 2, "the inputs' copies: {copied}");
+    // Started for one output and given to the write of another: not taken, and what it wrote
+    // for the first is removed.
+    let (first, second) = (dir.join("first"), dir.join("second"));
+    std::fs::create_dir_all(&first).unwrap();
+    std::fs::create_dir_all(&second).unwrap();
+    let started = CopiesAhead::start(&inputs[0], &first.join("out.gltf"), InputFiles::Copy);
+    write_lit_scene_with(
+        &inputs[0],
+        &second.join("out.gltf"),
+        &lights,
+        &opts,
+        Some(started),
+    )
+    .unwrap();
+    assert!(files(&first).is_empty(), "{:?}", files(&first));
+    assert_eq!(files(&second), files(&dir.join("end0")));
     // The external input beside its output, its buffer named as the output's copy of it.
     let src = &inputs[0];
     let folder = src.parent().unwrap();

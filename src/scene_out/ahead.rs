@@ -2,14 +2,14 @@
 //!
 //! The copies (the input's buffers and images beside the output, [`super::side_files`]) do
 //! not depend on the fit, yet they are most of what writing the output costs: the sample
-//! scene's 12 MB buffer, written and flushed to disk, took 0.02-0.17 s after a 0.9 s fit.
+//! scene's 12 MB buffer, written and flushed to disk, took 0.02-0.23 s after a 0.9 s fit.
 //! [`CopiesAhead::start`] stages the output and writes its copies to temporaries on a thread
 //! of their own from the start; [`super::write_lit_scene_with`] then puts them in place with
 //! the rest. When anything about that goes wrong (the folder is not there yet, a write
 //! fails), the output is staged and written at the end as without it, which reports the
 //! problem if there is one.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::thread::JoinHandle;
 
 use super::staged::{self, Staged};
@@ -19,6 +19,10 @@ use crate::output_file::WrittenAhead;
 /// The output staged, and its copies written, on a thread started before the fit (see the
 /// module doc). Dropped unused, it waits for the thread and removes what it wrote.
 pub struct CopiesAhead {
+    /// What it was started for: a write of anything else does not take it.
+    input: PathBuf,
+    output: PathBuf,
+    files: InputFiles,
     thread: Option<JoinHandle<Option<Ahead>>>,
 }
 
@@ -38,6 +42,7 @@ impl CopiesAhead {
                 .and_then(|e| e.to_str())
                 .is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
         let (input, output) = (input.to_path_buf(), output.to_path_buf());
+        let (for_input, for_output) = (input.clone(), output.clone());
         // A thread the system refuses leaves the copies to the end.
         let thread = copies.then(|| {
             std::thread::Builder::new()
@@ -55,12 +60,25 @@ impl CopiesAhead {
                 })
         });
         CopiesAhead {
+            input: for_input,
+            output: for_output,
+            files,
             thread: thread.and_then(Result::ok),
         }
     }
 
-    /// What the thread made, once it is done; `None` when it made nothing usable.
-    pub(super) fn finish(mut self) -> Option<Ahead> {
+    /// What the thread made for writing `input` as `output` with `files`, once it is done;
+    /// `None` when it made nothing usable, or was started for another write (what it wrote
+    /// is then removed).
+    pub(super) fn finish(
+        mut self,
+        input: &Path,
+        output: &Path,
+        files: InputFiles,
+    ) -> Option<Ahead> {
+        if (self.input.as_path(), self.output.as_path(), self.files) != (input, output, files) {
+            return None;
+        }
         self.thread.take()?.join().ok().flatten()
     }
 }

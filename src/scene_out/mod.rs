@@ -266,7 +266,8 @@ pub fn write_lit_scene_with(
         .enumerate()
         .map(|(i, l)| lights::prepare(l, i, options.nits_scale, options.light_offset))
         .collect::<Result<Vec<_>>>()?;
-    let (mut staged, written) = match ahead.and_then(CopiesAhead::finish) {
+    let finished = ahead.and_then(|a| a.finish(input, output, options.input_files));
+    let (mut staged, written) = match finished {
         Some(ahead) => (ahead.staged, ahead.written),
         None => (
             staged::stage(input, output, options.input_files)?,
