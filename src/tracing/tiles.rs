@@ -13,6 +13,8 @@ use std::ops::Range;
 use std::sync::{Mutex, OnceLock};
 use std::time::Duration;
 
+use rayon::prelude::*;
+
 use obvhs::{
     aabb::Aabb,
     cwbvh::{builder::build_cwbvh, CwBvh},
@@ -164,27 +166,42 @@ pub(super) fn tiles(triangles: &[Triangle], per_tile: usize) -> Vec<Tile> {
             k += 1;
         }
     }
-    // On one core: a tracer may be built lazily inside a parallel loop
-    // (`Scene::closest_hit_above_water`), where a rayon worker waiting for a half could take
-    // up a task of that loop which asks for this very tracer, and wait on itself.
+    // On every core only outside rayon's workers: a tracer may be built lazily inside a
+    // parallel loop (`Scene::closest_hit_above_water`), where a worker waiting for a half
+    // could take up a task of that loop which asks for this very tracer, and wait on
+    // itself. Either way the same tiles, in the same order.
+    let parallel = rayon::current_thread_index().is_none();
     let (first, rest) = items.split_at_mut(ordinary);
     let mut ranges = Vec::new();
-    split(first, 0, per_tile, &mut ranges);
-    split(rest, ordinary, per_tile, &mut ranges);
-    ranges
-        .into_iter()
-        .filter(|r| !r.is_empty())
-        .map(|r| {
-            let index: Vec<u32> = items[r].iter().map(|it| it.index).collect();
-            let tris = index.iter().map(|&i| triangles[i as usize]).collect();
-            Tile::new(tris, index)
-        })
-        .collect()
+    split(first, 0, per_tile, parallel, &mut ranges);
+    split(rest, ordinary, per_tile, parallel, &mut ranges);
+    let tile = |r: Range<usize>| {
+        let index: Vec<u32> = items[r].iter().map(|it| it.index).collect();
+        let tris = index.iter().map(|&i| triangles[i as usize]).collect();
+        Tile::new(tris, index)
+    };
+    let ranges = ranges.into_iter().filter(|r| !r.is_empty());
+    if parallel {
+        ranges
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(tile)
+            .collect()
+    } else {
+        ranges.map(tile).collect()
+    }
 }
 
 /// Halves `items` at the median of their centres along their widest axis until each part
-/// holds at most `per_tile`, and puts the parts' ranges, offset by `start`, in `out`.
-fn split(items: &mut [Item], start: usize, per_tile: usize, out: &mut Vec<Range<usize>>) {
+/// holds at most `per_tile`, and puts the parts' ranges, offset by `start`, in `out` (in the
+/// same order whether the halves are cut one after the other or, `parallel`, at once).
+fn split(
+    items: &mut [Item],
+    start: usize,
+    per_tile: usize,
+    parallel: bool,
+    out: &mut Vec<Range<usize>>,
+) {
     let whole = start..start + items.len();
     if items.len() <= per_tile {
         out.push(whole);
@@ -216,8 +233,23 @@ fn split(items: &mut [Item], start: usize, per_tile: usize, out: &mut Vec<Range<
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |a, b| a.centre[axis].total_cmp(&b.centre[axis]));
     let (left, right) = items.split_at_mut(mid);
-    split(left, start, per_tile, out);
-    split(right, start + mid, per_tile, out);
+    if parallel && items_worth_two_cores(mid) {
+        let mut right_out = Vec::new();
+        rayon::join(
+            || split(left, start, per_tile, parallel, out),
+            || split(right, start + mid, per_tile, parallel, &mut right_out),
+        );
+        out.append(&mut right_out);
+    } else {
+        split(left, start, per_tile, parallel, out);
+        split(right, start + mid, per_tile, parallel, out);
+    }
+}
+
+/// Whether halves of `n` items are worth cutting on two cores at once: below that the
+/// hand-over costs more than the cut.
+fn items_worth_two_cores(n: usize) -> bool {
+    n >= 1 << 14
 }
 
 /// The tiles' top level: a BVH over their boxes (the tiles in its leaf order).
@@ -234,4 +266,69 @@ pub(super) fn top_level(tiles: Vec<Tile>) -> (CwBvh, Vec<Tile>) {
         .filter_map(|&i| slots.get_mut(i as usize).and_then(Option::take))
         .collect();
     (bvh, ordered)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    /// The tiles cut on every core (outside rayon's workers) are those cut on one (inside a
+    /// worker): the same triangles, in the same order, tile by tile.
+    #[test]
+    fn tiles_cut_in_parallel_are_those_cut_on_one_core() {
+        // A bumpy grid of 2 x 160 x 160 triangles, shuffled, and a few large ones.
+        let n = 160;
+        let mut triangles = Vec::new();
+        let height = |x: usize, y: usize| ((x * 7 + y * 13) % 5) as f32 * 0.01;
+        for y in 0..n {
+            for x in 0..n {
+                let p = |dx: usize, dy: usize| {
+                    Vec3::new((x + dx) as f32, height(x + dx, y + dy), (y + dy) as f32)
+                };
+                triangles.push(Triangle {
+                    vertices: [p(0, 0), p(1, 0), p(0, 1)],
+                });
+                triangles.push(Triangle {
+                    vertices: [p(1, 0), p(1, 1), p(0, 1)],
+                });
+            }
+        }
+        for k in 0..3 {
+            let z = 10.0 * k as f32;
+            triangles.push(Triangle {
+                vertices: [
+                    Vec3::new(0.0, 0.0, z),
+                    Vec3::new(160.0, 0.0, z),
+                    Vec3::new(0.0, 40.0, z),
+                ],
+            });
+        }
+        let mut rng = crate::random::Rng::new(3, 0);
+        for i in (1..triangles.len()).rev() {
+            let j = (rng.next_u32() as usize) % (i + 1);
+            triangles.swap(i, j);
+        }
+        let indices = |tiles: Vec<Tile>| -> Vec<Vec<u32>> {
+            tiles
+                .into_iter()
+                .map(|t| {
+                    let pending = t.pending.into_inner().unwrap_or_else(|p| p.into_inner());
+                    pending.map(|(_, index)| index).unwrap_or_default()
+                })
+                .collect()
+        };
+        assert!(rayon::current_thread_index().is_none());
+        let parallel = indices(tiles(&triangles, 1000));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a thread pool");
+        let serial = indices(pool.install(|| tiles(&triangles, 1000)));
+        assert!(parallel.len() > 50, "{} tiles", parallel.len());
+        assert_eq!(parallel, serial);
+        let all: usize = parallel.iter().map(Vec::len).sum();
+        assert_eq!(all, triangles.len());
+    }
 }
