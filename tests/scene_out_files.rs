@@ -490,22 +490,19 @@ fn copies_written_ahead_are_the_files_written_at_the_end() {
     let inputs = generated_inputs(&dir);
     let lights = two_lights();
     let opts = WriteOptions::default();
+    // Every entry of a folder with its bytes (a folder by its name alone).
     let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
-        let mut all: Vec<(String, Vec<u8>)> = std::fs::read_dir(d)
-            .unwrap()
-            .map(|e| {
-                let e = e.unwrap();
-                // A folder by its name alone.
-                let bytes = if e.path().is_dir() {
+        sorted_paths(d)
+            .into_iter()
+            .map(|p| {
+                let bytes = if p.is_dir() {
                     Vec::new()
                 } else {
-                    std::fs::read(e.path()).unwrap()
+                    std::fs::read(&p).unwrap()
                 };
-                (e.file_name().to_string_lossy().into_owned(), bytes)
+                (p.file_name().unwrap().to_string_lossy().into_owned(), bytes)
             })
-            .collect();
-        all.sort();
-        all
+            .collect()
     };
     let mut copied = 0;
     for (k, input) in inputs.iter().enumerate() {
