@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::light_plane::{reflected_sample, LightPlane};
 use super::rect::Rect;
+use super::PIXELS_PER_TASK;
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
 use crate::scene_in::Scene;
@@ -108,6 +109,7 @@ pub fn footprints(
 ) -> Vec<Footprint> {
     probes
         .par_iter()
+        .with_max_len(PIXELS_PER_TASK)
         .map(|&(pixel, radius)| {
             footprint_with(
                 water_model,

@@ -164,8 +164,11 @@ impl Scene {
                 return kept;
             }
         }
-        let hits: Vec<Entry> = (y0..=y1)
+        let hits: Vec<Entry> = (y0..y1 + 1)
             .into_par_iter()
+            // A few rows a task: the rows that see the water cost many times those that
+            // see the sky, and a long last task would leave the other cores idle.
+            .with_max_len(2)
             .flat_map_iter(|y| {
                 (x0..=x1).map(move |x| {
                     if skip(index(x, y)) {

@@ -131,6 +131,7 @@ mod samples;
 mod significance;
 mod split;
 mod stacked;
+mod store;
 mod trace;
 mod uncertainty;
 

@@ -82,6 +82,7 @@ pub(super) fn region(
             .collect();
         let seen: Vec<u32> = candidates
             .into_par_iter()
+            .with_max_len(crate::fitting::PIXELS_PER_TASK)
             .filter(|&i| sees_region_of_interest(water_model, scene, model, planes, roi, i, photo))
             .collect();
         pixels.extend(seen);

@@ -84,41 +84,6 @@ pub(super) struct Recorded {
     pub drew: Vec<f32>,
 }
 
-impl Recorded {
-    /// Gathers the pixels' records into the planes' order (each pixel's samples of plane `k`
-    /// in the order they were stored). `hits` and `records` per pixel, `counts` the samples
-    /// per plane.
-    pub fn gather<H>(
-        per_pixel: Vec<(Vec<super::direct::Hit>, H, Option<Box<PixelRecord>>)>,
-        planes: usize,
-        counts: &[usize],
-    ) -> Self {
-        let mut lobes: Vec<Vec<SampleLobe>> =
-            counts.iter().map(|&n| Vec::with_capacity(n)).collect();
-        let mut rays = Vec::with_capacity(per_pixel.len());
-        let mut water = Vec::with_capacity(per_pixel.len());
-        let mut drew = Vec::with_capacity(per_pixel.len());
-        for (hits, _, record) in per_pixel {
-            let record = record.unwrap_or_default();
-            for (hit, lobe) in hits.iter().zip(&record.lobes) {
-                if let Some(l) = lobes.get_mut(hit.0 as usize) {
-                    l.push(*lobe);
-                }
-            }
-            rays.push(record.rays);
-            water.push(record.water);
-            drew.push(record.drew);
-        }
-        debug_assert_eq!(lobes.len(), planes);
-        Recorded {
-            lobes,
-            rays,
-            water,
-            drew,
-        }
-    }
-}
-
 /// The samples of every plane of a trace recorded under a proposal lobe (`base` and `lobes`
 /// per plane, its samples and their lobes; `rays`, `water` and `drew` per pixel), weighted
 /// for the lobe `target` (`model` gives the IOR and the geometry term; module doc): each
@@ -142,6 +107,7 @@ pub(super) fn reweighted(
     // Pixel by pixel, its Gaussian on each plane in turn.
     let matched: Vec<LobeGaussian> = (0..water.len())
         .into_par_iter()
+        .with_max_len(crate::fitting::PIXELS_PER_TASK)
         .flat_map_iter(|i| {
             let drawn = water[i].map(|w| {
                 let (dirs, count) = lobe_directions(target.water_model(), &target_model, &w);
@@ -185,6 +151,7 @@ fn reweighted_plane(
     let pixels = base.offsets.len() - 1;
     let weights: Vec<f32> = (0..pixels)
         .into_par_iter()
+        .with_max_len(crate::fitting::PIXELS_PER_TASK)
         .flat_map_iter(|i| {
             let r = base.range(i);
             let g = gauss[i];

@@ -3,16 +3,16 @@
 //! [`PlaneSamples`] where they land inside the plane's region of interest.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
 
 use glam::Vec2;
 use rayon::prelude::*;
 
 use super::control_variate::{self, LobeGaussian};
 use super::direct::{direct_hits, Hit, DIRECT_RAYS};
-use super::kernel::{cell_half_extents, smallest_light, LobeNeighbours, POINT_CELL};
+use super::kernel::{cell_half_extents, LobeNeighbours};
 use super::reweight::{PixelRecord, Recorded, SampleLobe};
 use super::samples::{effective_samples, lobe_strata, PlaneSamples, CAMERA_STRATA};
+use super::store::{store, Traced};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::optics::{compact_strata, ReflectionModel};
@@ -97,8 +97,6 @@ pub(super) fn trace_recorded(
     record: bool,
     progress: Reporter<'_>,
 ) -> (Vec<PlaneSamples>, u32, Option<Recorded>) {
-    // The record only when asked: a pixel of a plain trace carries no more than before.
-    type Hits = (Vec<Hit>, Vec<LobeGaussian>, Option<Box<PixelRecord>>);
     let lobe = lobe_strata(samples);
     let per_pixel_samples = effective_samples(samples);
     let direct_weight = per_pixel_samples as f32 / DIRECT_RAYS as f32;
@@ -112,8 +110,9 @@ pub(super) fn trace_recorded(
     // region's own order the first half of Table 1's pixels took a twentieth of the time, so
     // the progress's time left came out many times too short.
     let order = interleaved(pixels.len());
-    let traced_in_order: Vec<Hits> = order
+    let traced_in_order: Vec<Traced> = order
         .par_iter()
+        .with_max_len(crate::fitting::PIXELS_PER_TASK)
         .map(|&index| {
             let pixel = pixels[index];
             let done = traced.fetch_add(1, Ordering::Relaxed) + 1;
@@ -300,76 +299,12 @@ pub(super) fn trace_recorded(
             (hits, gauss, recorded)
         })
         .collect();
-    let mut slots: Vec<Option<Hits>> = (0..pixels.len()).map(|_| None).collect();
+    let mut slots: Vec<Option<Traced>> = (0..pixels.len()).map(|_| None).collect();
     for (hits, &index) in traced_in_order.into_iter().zip(&order) {
         slots[index] = Some(hits);
     }
-    let per_pixel: Vec<Hits> = slots.into_iter().map(Option::unwrap_or_default).collect();
-    // Each plane's samples, counted first so that its vectors are allocated once, at their
-    // size.
-    let mut counts = vec![0usize; planes.len()];
-    for (hits, _, _) in &per_pixel {
-        for hit in hits {
-            if let Some(c) = counts.get_mut(hit.0 as usize) {
-                *c += 1;
-            }
-        }
-    }
-    let stored = (0..planes.len())
-        .map(|k| {
-            let n = counts[k];
-            let mut offsets = Vec::with_capacity(pixels.len() + 1);
-            let mut bbox = Vec::with_capacity(pixels.len());
-            let mut points = Vec::with_capacity(n);
-            let mut cells = Vec::with_capacity(n);
-            let mut weights = Vec::with_capacity(n);
-            let mut halves = Vec::with_capacity(n);
-            let mut by_v = Vec::with_capacity(n);
-            let mut reaches = Vec::with_capacity(pixels.len());
-            let mut gausses = Vec::with_capacity(pixels.len());
-            offsets.push(0);
-            for (hits, gauss, _) in &per_pixel {
-                gausses.push(gauss[k]);
-                let first = points.len();
-                for &(kk, p, cell, w, half, v_order) in hits {
-                    if kk as usize == k {
-                        points.push(p);
-                        cells.push(cell);
-                        weights.push(w);
-                        halves.push(half);
-                        by_v.push(v_order);
-                    }
-                }
-                let mut bb = Rect::EMPTY;
-                let mut reach = Vec2::splat(POINT_CELL);
-                for (p, h) in points[first..].iter().zip(&cells[first..]) {
-                    bb = bb.union(&Rect::around(*p, h.abs()));
-                    reach = reach.max(h.abs());
-                }
-                bbox.push(bb);
-                reaches.push(reach);
-                offsets.push(points.len() as u32);
-            }
-            let distance = planes[k].camera_distance();
-            // From the water pixels' samples alone: the bound is about the lobes' kernels.
-            let lobe_samples = offsets[first_direct.min(pixels.len())] as usize;
-            let min_size = smallest_light(&cells[..lobe_samples], distance);
-            PlaneSamples {
-                offsets: Arc::new(offsets),
-                bbox: Arc::new(bbox),
-                points: Arc::new(points),
-                cells: Arc::new(cells),
-                weights,
-                halves: Arc::new(halves),
-                by_v: Arc::new(by_v),
-                reach: Arc::new(reaches),
-                gauss: gausses,
-                min_size,
-                distance,
-            }
-        })
-        .collect();
-    let recorded = record.then(|| Recorded::gather(per_pixel, planes.len(), &counts));
+    let per_pixel: Vec<Traced> = slots.into_iter().map(Option::unwrap_or_default).collect();
+    let (stored, recorded) = store(per_pixel, planes, first_direct, record);
     (stored, per_pixel_samples, recorded)
 }
 
