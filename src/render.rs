@@ -203,6 +203,22 @@ impl WaterPoint {
         (self.face.dot(sample.wi) > 0.0).then_some(sample)
     }
 
+    /// [`reflect`](Self::reflect) from the half vector `draw` that `model` drew
+    /// ([`ReflectionModel::draw`]): the same sample to the last bit.
+    pub fn reflect_drawn(
+        &self,
+        model: &ReflectionModel,
+        draw: &crate::optics::HalfDraw,
+    ) -> Option<crate::optics::LobeSample> {
+        let sample = model.sample_drawn(
+            self.normal,
+            crate::optics::orthonormal_basis(self.normal),
+            self.wo,
+            draw,
+        )?;
+        (self.face.dot(sample.wi) > 0.0).then_some(sample)
+    }
+
     /// The direction of [`reflect`](Self::reflect)'s sample for `u`, without its weight.
     pub fn reflect_direction(&self, model: &ReflectionModel, u: Vec2) -> Option<Vec3> {
         let wi = model.direction(self.normal, self.wo, u)?;

@@ -65,7 +65,22 @@ impl GaussianSlopes {
         wo: Vec3,
         u: Vec2,
     ) -> Option<LobeSample> {
-        let m = self.mirror(n, t, wo, u)?;
+        self.sample_drawn(model, n, t, wo, &self.draw(u))
+    }
+
+    /// [`sample`](Self::sample) from the slope `draw` (of [`draw`](Self::draw)): the same
+    /// sample to the last bit. Where many water points read the same uniform pairs (the
+    /// control variate's grid), the draws are made once.
+    #[inline]
+    pub fn sample_drawn(
+        &self,
+        model: &ReflectionModel,
+        n: Vec3,
+        t: Vec3,
+        wo: Vec3,
+        draw: &SlopeDraw,
+    ) -> Option<LobeSample> {
+        let m = self.mirror(n, t, wo, draw)?;
         let fresnel = fresnel_dielectric(m.cos_oh, model.ior);
         let g = match model.shadowing {
             Shadowing::None => energy_cap(m.cos_o, m.cos_h, m.cos_oh, fresnel),
@@ -87,7 +102,23 @@ impl GaussianSlopes {
     /// weight.
     #[inline]
     pub fn direction(&self, n: Vec3, t: Vec3, wo: Vec3, u: Vec2) -> Option<Vec3> {
-        self.mirror(n, t, wo, u).map(|m| m.wi)
+        self.mirror(n, t, wo, &self.draw(u)).map(|m| m.wi)
+    }
+
+    /// The slope drawn from `u` (module doc): what depends on `u` and the variances alone.
+    #[inline]
+    pub fn draw(&self, u: Vec2) -> SlopeDraw {
+        let xi = CONE_LOST_MASS as f32 + KEEP * u.x;
+        let r = (-2.0 * xi.ln()).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (std::f32::consts::TAU * u.y).sin_cos();
+        let p_t = self.variance[0].sqrt() * r * cos_phi;
+        let p_b = self.variance[1].sqrt() * r * sin_phi;
+        SlopeDraw {
+            xi,
+            p_t,
+            p_b,
+            inv_len: 1.0 / (1.0 + p_t * p_t + p_b * p_b).sqrt(),
+        }
     }
 
     /// `f(wo, wi) (n.wi)` of this lobe for [`ReflectionModel`]'s `ior` and `shadowing`: the
@@ -137,18 +168,18 @@ impl GaussianSlopes {
     }
 
     #[inline]
-    fn mirror(&self, n: Vec3, t: Vec3, wo: Vec3, u: Vec2) -> Option<Mirrored> {
+    fn mirror(&self, n: Vec3, t: Vec3, wo: Vec3, draw: &SlopeDraw) -> Option<Mirrored> {
         let cos_o = n.dot(wo);
         if cos_o <= 0.0 {
             return None;
         }
-        let xi = CONE_LOST_MASS as f32 + KEEP * u.x;
-        let r = (-2.0 * xi.ln()).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = (std::f32::consts::TAU * u.y).sin_cos();
-        let p_t = self.variance[0].sqrt() * r * cos_phi;
-        let p_b = self.variance[1].sqrt() * r * sin_phi;
+        let SlopeDraw {
+            xi,
+            p_t,
+            p_b,
+            inv_len,
+        } = *draw;
         let b = n.cross(t);
-        let inv_len = 1.0 / (1.0 + p_t * p_t + p_b * p_b).sqrt();
         let h = (n - t * p_t - b * p_b) * inv_len;
         let cos_h = inv_len;
         let cos_oh = wo.dot(h);
@@ -169,6 +200,18 @@ impl GaussianSlopes {
             cos_i,
         })
     }
+}
+
+/// A slope drawn for [`GaussianSlopes::sample`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlopeDraw {
+    /// `CONE_LOST_MASS + (1 - CONE_LOST_MASS) u.x`, as drawn.
+    xi: f32,
+    /// The slope along `t` and along `b`.
+    p_t: f32,
+    p_b: f32,
+    /// `1 / sqrt(1 + p_t^2 + p_b^2)`: `n.h`.
+    inv_len: f32,
 }
 
 /// A drawn direction and the cosines its weight needs.

@@ -70,7 +70,22 @@ impl ReflectionModel {
     /// the surface (`n.wi <= 0`). Those samples count as zero in every estimate.
     #[inline]
     pub fn sample(&self, n: Vec3, wo: Vec3, u: Vec2) -> Option<LobeSample> {
-        let m = self.mirror(n, wo, u)?;
+        self.sample_drawn(n, orthonormal_basis(n), wo, &self.draw(u))
+    }
+
+    /// [`sample`](Self::sample) from the half vector `draw` (of [`draw`](Self::draw)) about
+    /// `n`, whose tangents `frame` are [`orthonormal_basis`]`(n)`: the same sample to the last
+    /// bit. Where many water points read the same uniform pairs (the control variate's grid),
+    /// the draws and each point's frame are made once.
+    #[inline]
+    pub fn sample_drawn(
+        &self,
+        n: Vec3,
+        frame: (Vec3, Vec3),
+        wo: Vec3,
+        draw: &HalfDraw,
+    ) -> Option<LobeSample> {
+        let m = self.mirror(n, frame, wo, draw)?;
         let fresnel = fresnel_dielectric(m.cos_oh, self.ior);
         let g = self
             .shadowing
@@ -91,16 +106,14 @@ impl ReflectionModel {
     /// weight: for neighbouring directions, where only the geometry is wanted.
     #[inline]
     pub fn direction(&self, n: Vec3, wo: Vec3, u: Vec2) -> Option<Vec3> {
-        self.mirror(n, wo, u).map(|m| m.wi)
+        self.mirror(n, orthonormal_basis(n), wo, &self.draw(u))
+            .map(|m| m.wi)
     }
 
-    /// `wo` mirrored about the half vector drawn from `u` (see [`sample`](Self::sample)).
+    /// The half vector drawn from `u`, in the frame of the normal (see
+    /// [`sample`](Self::sample)): what depends on `u` and the gloss alone.
     #[inline]
-    fn mirror(&self, n: Vec3, wo: Vec3, u: Vec2) -> Option<Mirrored> {
-        let cos_o = n.dot(wo);
-        if cos_o <= 0.0 {
-            return None;
-        }
+    pub fn draw(&self, u: Vec2) -> HalfDraw {
         let xi = CONE_LOST_MASS as f32 + KEEP * u.x;
         let log_cos_h = xi.ln() / (self.gloss + 2.0);
         let cos_h = log_cos_h.exp();
@@ -108,8 +121,29 @@ impl ReflectionModel {
         // of one and the direct difference would keep only a few significant digits.
         let sin_h = (-(2.0 * log_cos_h).exp_m1()).max(0.0).sqrt();
         let (sin_phi, cos_phi) = (std::f32::consts::TAU * u.y).sin_cos();
-        let (t, b) = orthonormal_basis(n);
-        let h = t * (sin_h * cos_phi) + b * (sin_h * sin_phi) + n * cos_h;
+        HalfDraw {
+            xi,
+            cos_h,
+            sin_h_cos_phi: sin_h * cos_phi,
+            sin_h_sin_phi: sin_h * sin_phi,
+        }
+    }
+
+    /// `wo` mirrored about the half vector `draw` about `n` (tangents `(t, b)`; see
+    /// [`sample`](Self::sample)).
+    #[inline]
+    fn mirror(&self, n: Vec3, (t, b): (Vec3, Vec3), wo: Vec3, draw: &HalfDraw) -> Option<Mirrored> {
+        let cos_o = n.dot(wo);
+        if cos_o <= 0.0 {
+            return None;
+        }
+        let HalfDraw {
+            xi,
+            cos_h,
+            sin_h_cos_phi,
+            sin_h_sin_phi,
+        } = *draw;
+        let h = t * sin_h_cos_phi + b * sin_h_sin_phi + n * cos_h;
         let cos_oh = wo.dot(h);
         if cos_oh <= 0.0 {
             return None;
@@ -193,6 +227,17 @@ impl ReflectionModel {
             cos_oh: wo.dot(h),
         })
     }
+}
+
+/// A half vector drawn for [`ReflectionModel::sample`], in the frame of the normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfDraw {
+    /// `(n.h)^(e+2)`, as drawn.
+    xi: f32,
+    cos_h: f32,
+    /// The tangent components: `sin theta_h cos phi`, `sin theta_h sin phi`.
+    sin_h_cos_phi: f32,
+    sin_h_sin_phi: f32,
 }
 
 /// A drawn direction and the cosines its weight needs.

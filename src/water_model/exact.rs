@@ -6,7 +6,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::WaterModel;
+use super::{LobeDraws, WaterModel};
 use crate::optics::{LobeSample, ReflectionModel};
 use crate::render::{camera_hit, CameraHit, WaterPoint};
 use crate::scene_in::Scene;
@@ -45,5 +45,23 @@ impl WaterModel for ExactSurface {
         u: Vec2,
     ) -> Option<Vec3> {
         point.reflect_direction(model, u)
+    }
+
+    fn lobe_draws(&self, model: &ReflectionModel, pairs: &[Vec2]) -> LobeDraws {
+        LobeDraws::microfacet(model, pairs)
+    }
+
+    #[inline]
+    fn reflect_drawn(
+        &self,
+        point: &WaterPoint,
+        model: &ReflectionModel,
+        draws: &LobeDraws,
+        i: usize,
+    ) -> Option<LobeSample> {
+        match draws.half(i, model.gloss) {
+            Some(draw) => point.reflect_drawn(model, draw),
+            None => point.reflect(model, draws.pair(i)),
+        }
     }
 }

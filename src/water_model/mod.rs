@@ -32,12 +32,14 @@
 //! lobe. The fitters take a `&dyn WaterModel` ([`crate::fitting::fit_paper_with`],
 //! [`crate::fitting::joint::fit_joint_with`]); the plain entry points use the exact model.
 
+pub mod draws;
 pub mod exact;
 pub mod mean_surface;
 pub mod statistical;
 
 use glam::{Vec2, Vec3};
 
+pub use draws::LobeDraws;
 pub use exact::ExactSurface;
 pub use mean_surface::{water_statistics, MeanSurface, WaterStatistics};
 pub use statistical::StatisticalSurface;
@@ -111,6 +113,27 @@ pub trait WaterModel: Sync + std::fmt::Debug {
         model: &ReflectionModel,
         u: Vec2,
     ) -> Option<Vec3>;
+
+    /// What [`reflect`](Self::reflect) draws from each of `pairs` under `model` that depends
+    /// on the pair and the lobe alone, made once for the many points that read the same
+    /// pairs ([`draws`]). By default the pairs themselves.
+    fn lobe_draws(&self, model: &ReflectionModel, pairs: &[Vec2]) -> LobeDraws {
+        let _ = model;
+        LobeDraws::pairs(pairs)
+    }
+
+    /// [`reflect`](Self::reflect) of `point` under `model` for the `i`-th pair of `draws`:
+    /// the same sample to the last bit, from draws this model made for `model` without
+    /// drawing again (from any others, drawn again from the pair).
+    fn reflect_drawn(
+        &self,
+        point: &WaterPoint,
+        model: &ReflectionModel,
+        draws: &LobeDraws,
+        i: usize,
+    ) -> Option<LobeSample> {
+        self.reflect(point, model, draws.pair(i))
+    }
 }
 
 #[cfg(test)]

@@ -28,7 +28,7 @@
 use glam::{Vec2, Vec3};
 
 use super::mean_surface::MeanSurface;
-use super::WaterModel;
+use super::{LobeDraws, WaterModel};
 use crate::optics::{GaussianSlopes, LobeSample, ReflectionModel, Shadowing};
 use crate::render::{camera_hit, surface_offset, CameraHit, WaterPoint};
 use crate::scene_in::Scene;
@@ -115,6 +115,31 @@ impl WaterModel for StatisticalSurface {
     ) -> Option<Vec3> {
         self.slopes(model.gloss)
             .direction(point.normal, self.surface.along, point.wo, u)
+    }
+
+    fn lobe_draws(&self, model: &ReflectionModel, pairs: &[Vec2]) -> LobeDraws {
+        LobeDraws::slopes(self.slopes(model.gloss), pairs)
+    }
+
+    #[inline]
+    fn reflect_drawn(
+        &self,
+        point: &WaterPoint,
+        model: &ReflectionModel,
+        draws: &LobeDraws,
+        i: usize,
+    ) -> Option<LobeSample> {
+        let slopes = self.slopes(model.gloss);
+        match draws.slope(i, &slopes) {
+            Some(draw) => slopes.sample_drawn(
+                &masked(model),
+                point.normal,
+                self.surface.along,
+                point.wo,
+                draw,
+            ),
+            None => self.reflect(point, model, draws.pair(i)),
+        }
     }
 }
 

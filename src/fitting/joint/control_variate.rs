@@ -27,7 +27,7 @@ use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::optics::{compact_strata, ReflectionModel};
 use crate::render::WaterPoint;
-use crate::water_model::WaterModel;
+use crate::water_model::{LobeDraws, WaterModel};
 
 /// Strata per side of the fixed grid of lobe directions a [`LobeGaussian`] is matched to.
 /// 8 (64 directions) reduced Table 3's error as much as 16 within the seeds' spread, for a
@@ -140,25 +140,38 @@ impl LobeGaussian {
     }
 }
 
+/// The fixed grid's uniform pairs (strata centres, through [`compact_strata`]), drawn by
+/// `water_model` under `model` once for every water point that [`lobe_directions`] reads
+/// them for.
+pub(super) fn grid_draws(water_model: &dyn WaterModel, model: &ReflectionModel) -> LobeDraws {
+    let pairs: Vec<Vec2> = (0..GRID * GRID)
+        .map(|i| {
+            compact_strata(Vec2::new(
+                ((i % GRID) as f32 + 0.5) / GRID as f32,
+                ((i / GRID) as f32 + 0.5) / GRID as f32,
+            ))
+        })
+        .collect();
+    water_model.lobe_draws(model, &pairs)
+}
+
 /// The fixed grid of lobe directions (strata centres) of a water point, with their sample
 /// weights, and how many were drawn (those the model rejects are left out, as zeros).
+/// `grid` is [`grid_draws`] of the same model.
 pub(super) fn lobe_directions(
     water_model: &dyn WaterModel,
     model: &ReflectionModel,
     water: &WaterPoint,
+    grid: &LobeDraws,
 ) -> (Vec<(Vec3, f32)>, usize) {
-    let dirs = (0..GRID * GRID)
+    let dirs = (0..grid.len())
         .filter_map(|i| {
-            let u = compact_strata(Vec2::new(
-                ((i % GRID) as f32 + 0.5) / GRID as f32,
-                ((i / GRID) as f32 + 0.5) / GRID as f32,
-            ));
             water_model
-                .reflect(water, model, u)
+                .reflect_drawn(water, model, grid, i)
                 .map(|s| (s.wi, s.weight))
         })
         .collect();
-    (dirs, (GRID * GRID) as usize)
+    (dirs, grid.len())
 }
 
 /// The normal distribution's mass between `lo` and `hi`.

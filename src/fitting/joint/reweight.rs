@@ -27,7 +27,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::control_variate::{lobe_directions, LobeGaussian};
+use super::control_variate::{grid_draws, lobe_directions, LobeGaussian};
 use super::proposal::Lobe;
 use super::samples::PlaneSamples;
 use crate::fitting::light_plane::LightPlane;
@@ -104,13 +104,14 @@ pub(super) fn reweighted(
     model: &ReflectionModel,
 ) -> Vec<PlaneSamples> {
     let target_model = target.model(model);
+    let grid = grid_draws(target.water_model(), &target_model);
     // Pixel by pixel, its Gaussian on each plane in turn.
     let matched: Vec<LobeGaussian> = (0..water.len())
         .into_par_iter()
         .with_max_len(crate::fitting::PIXELS_PER_TASK)
         .flat_map_iter(|i| {
             let drawn = water[i].map(|w| {
-                let (dirs, count) = lobe_directions(target.water_model(), &target_model, &w);
+                let (dirs, count) = lobe_directions(target.water_model(), &target_model, &w, &grid);
                 (w, dirs, count)
             });
             planes.iter().map(move |plane| match &drawn {

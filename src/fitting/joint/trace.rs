@@ -110,6 +110,8 @@ pub(super) fn trace_recorded(
     // region's own order the first half of Table 1's pixels took a twentieth of the time, so
     // the progress's time left came out many times too short.
     let order = interleaved(pixels.len());
+    // The control variates' grid of lobe directions, drawn once for every pixel.
+    let grid = control_variate::grid_draws(water_model, model);
     let traced_in_order: Vec<Traced> = order
         .par_iter()
         .with_max_len(crate::fitting::PIXELS_PER_TASK)
@@ -197,7 +199,7 @@ pub(super) fn trace_recorded(
                         return vec![LobeGaussian::NONE; planes.len()];
                     }
                     let (dirs, count) =
-                        control_variate::lobe_directions(water_model, model, &water);
+                        control_variate::lobe_directions(water_model, model, &water, &grid);
                     planes
                         .iter()
                         .map(|plane| LobeGaussian::matched(plane, water.start, &dirs, count))
