@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use image::{DynamicImage, ImageDecoder};
+use rayon::prelude::*;
 
 use crate::photo_rounding::Rounding;
 use crate::settings::Setting;
@@ -109,12 +110,15 @@ impl Photo {
     /// Builds a photo from sRGB-encoded values in [0, 1] (as an 8-bit file would hold them,
     /// divided by 255: its [`rounding`](Self::rounding)), marking values at 1 as clipped.
     pub fn from_display(width: u32, height: u32, display: Vec<[f32; 3]>, exposure: f32) -> Self {
+        // On every core: three powers a pixel, 0.2 s of a 4000 x 3000 photo on one.
         let radiance = display
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|p| p.map(|c| srgb_to_linear(c) / exposure))
             .collect();
         let clipped = display
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|p| p.iter().any(|&c| c >= 1.0))
             .collect();
         Photo {
