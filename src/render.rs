@@ -20,7 +20,7 @@ use crate::progress::Reporter;
 use crate::random::Rng;
 use crate::scene_in::{AreaLight, Scene};
 use crate::settings::Setting;
-use crate::tracing::Hit;
+use crate::tracing::{Hit, PACKET_RAYS};
 use crate::water_model::WaterModel;
 use crate::{Error, Result};
 
@@ -195,6 +195,25 @@ impl WaterPoint {
         }
     }
 
+    /// [`reflected_hit`](Self::reflected_hit) of each direction of `wi` within its `tmax`,
+    /// into `hits` (as long as both). The exact model's rays, which leave one point, are
+    /// traced together ([`crate::tracing::Tracer::closest_hits`]).
+    pub fn reflected_hits(
+        &self,
+        scene: &Scene,
+        wi: &[Vec3],
+        tmax: &[f32],
+        hits: &mut [Option<Hit>],
+    ) {
+        if self.clear > 0.0 {
+            for ((&wi, &tmax), hit) in wi.iter().zip(tmax).zip(hits) {
+                *hit = self.reflected_hit(scene, wi, tmax);
+            }
+        } else {
+            scene.tracer.closest_hits(self.start, wi, 0.0, tmax, hits);
+        }
+    }
+
     /// One reflected lobe sample for the uniform pair `u`; `None` when the model rejects it
     /// or the ray would enter the water geometrically (it then sees nothing, but still
     /// counts in the pixel's mean).
@@ -254,16 +273,62 @@ pub fn camera_hit(
         SceneHit::Miss => return CameraHit::Other,
         SceneHit::Surface(hit) => hit,
     };
-    if !scene.is_water[hit.triangle as usize] {
-        return CameraHit::Other;
+    match water_point_of(scene, dir, &hit) {
+        Some(water) => CameraHit::Water(water),
+        None => CameraHit::Other,
     }
-    let p = origin + dir * hit.t;
+}
+
+/// [`camera_hit`]'s water point, without lights, for each image position of `positions`
+/// (pixel units, fractional), into `points` (as long; `None` where the ray sees anything
+/// else first, or nothing). The rays are traced in packets ([`crate::tracing::Tracer::closest_hits`]):
+/// a pixel's camera rays run close together.
+pub fn camera_water_points(
+    scene: &Scene,
+    positions: &[Vec2],
+    width: u32,
+    height: u32,
+    points: &mut [Option<WaterPoint>],
+) {
+    let origin = scene.camera.position;
+    for (positions, points) in positions
+        .chunks(PACKET_RAYS)
+        .zip(points.chunks_mut(PACKET_RAYS))
+    {
+        let n = positions.len();
+        let mut dirs = [Vec3::ZERO; PACKET_RAYS];
+        for (dir, p) in dirs.iter_mut().zip(positions) {
+            *dir = scene.camera.direction(p.x, p.y, width, height);
+        }
+        let mut hits = [None; PACKET_RAYS];
+        scene.tracer.closest_hits(
+            origin,
+            &dirs[..n],
+            0.0,
+            &[f32::INFINITY; PACKET_RAYS][..n],
+            &mut hits[..n],
+        );
+        for ((point, hit), dir) in points.iter_mut().zip(&hits).zip(&dirs) {
+            *point = hit
+                .as_ref()
+                .and_then(|hit| water_point_of(scene, *dir, hit));
+        }
+    }
+}
+
+/// The water point of the camera ray in direction `dir` whose first hit is `hit`, or `None`
+/// when that is not the water.
+fn water_point_of(scene: &Scene, dir: Vec3, hit: &Hit) -> Option<WaterPoint> {
+    if !scene.is_water[hit.triangle as usize] {
+        return None;
+    }
+    let p = scene.camera.position + dir * hit.t;
     let wo = -dir;
     let mut face = scene.face_normal(hit.triangle);
     if face.dot(wo) < 0.0 {
         face = -face;
     }
-    CameraHit::Water(WaterPoint {
+    Some(WaterPoint {
         start: p + face * surface_offset(p),
         wo,
         normal: scene.shading_normal(hit.triangle, hit.barycentric),

@@ -7,6 +7,7 @@
 //! water. The watertight test decides every edge consistently for both triangles that share
 //! it. Boxes are padded a little so that a hit exactly on a box face is not culled.
 
+mod packet;
 mod tiles;
 
 use glam::{Vec3, Vec3A};
@@ -17,6 +18,7 @@ use obvhs::{
     Boundable,
 };
 
+pub use packet::PACKET_RAYS;
 use tiles::Tile;
 
 /// The most triangles a tile holds: small enough that the tiles no ray reaches are left

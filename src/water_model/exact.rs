@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 
 use super::{LobeDraws, WaterModel};
 use crate::optics::{LobeSample, ReflectionModel};
-use crate::render::{camera_hit, CameraHit, WaterPoint};
+use crate::render::{camera_hit, camera_water_points, CameraHit, WaterPoint};
 use crate::scene_in::Scene;
 
 /// The water is the scene's water mesh (see the module doc).
@@ -30,6 +30,17 @@ impl WaterModel for ExactSurface {
             CameraHit::Water(water) => Some(water),
             CameraHit::Light(_) | CameraHit::Other => None,
         }
+    }
+
+    fn water_points(
+        &self,
+        scene: &Scene,
+        positions: &[Vec2],
+        width: u32,
+        height: u32,
+        points: &mut [Option<WaterPoint>],
+    ) {
+        camera_water_points(scene, positions, width, height, points);
     }
 
     #[inline]

@@ -87,6 +87,22 @@ pub trait WaterModel: Sync + std::fmt::Debug {
         height: u32,
     ) -> Option<WaterPoint>;
 
+    /// [`water_point`](Self::water_point) for each image position of `positions` (pixel
+    /// units), into `points` (as long): the same points. A model that traces the camera's
+    /// rays traces them together here (a pixel's camera rays run close together).
+    fn water_points(
+        &self,
+        scene: &Scene,
+        positions: &[Vec2],
+        width: u32,
+        height: u32,
+        points: &mut [Option<WaterPoint>],
+    ) {
+        for (p, point) in positions.iter().zip(points) {
+            *point = self.water_point(scene, p.x, p.y, width, height);
+        }
+    }
+
     /// The lobe sample of `point` for the uniform pair `u` in [0, 1)^2, under the microfacet
     /// model `model` (its gloss and IOR: the fits vary the gloss): the unit direction `wi`
     /// towards the light, its weight `f cos / pdf` (Fresnel and everything else included, so

@@ -30,7 +30,7 @@ use glam::{Vec2, Vec3};
 use super::mean_surface::MeanSurface;
 use super::{LobeDraws, WaterModel};
 use crate::optics::{GaussianSlopes, LobeSample, ReflectionModel, Shadowing};
-use crate::render::{camera_hit, surface_offset, CameraHit, WaterPoint};
+use crate::render::{camera_hit, camera_water_points, surface_offset, CameraHit, WaterPoint};
 use crate::scene_in::Scene;
 
 /// The water as a mean surface under waves of Gaussian slopes (see the module doc).
@@ -44,6 +44,29 @@ pub struct StatisticalSurface {
 }
 
 impl StatisticalSurface {
+    /// Where the camera ray through image position (`x`, `y`) meets the mean surface, as the
+    /// water point of a camera ray that sees the water.
+    fn on_mean_surface(
+        &self,
+        scene: &Scene,
+        x: f32,
+        y: f32,
+        width: u32,
+        height: u32,
+    ) -> Option<WaterPoint> {
+        let origin = scene.camera.position;
+        let dir = scene.camera.direction(x, y, width, height);
+        let (p, _) = self.surface.hit(origin, dir)?;
+        let n = self.surface.normal;
+        Some(WaterPoint {
+            start: p + n * surface_offset(p),
+            wo: -dir,
+            normal: n,
+            face: n,
+            clear: self.surface.crest,
+        })
+    }
+
     /// The lobe at gloss `gloss`: microfacets and waves.
     pub fn slopes(&self, gloss: f32) -> GaussianSlopes {
         GaussianSlopes::microfacets_and_waves(gloss, self.waves)
@@ -79,20 +102,25 @@ impl WaterModel for StatisticalSurface {
         height: u32,
     ) -> Option<WaterPoint> {
         match camera_hit(scene, &[], x, y, width, height) {
-            CameraHit::Water(_) => {}
-            CameraHit::Light(_) | CameraHit::Other => return None,
+            CameraHit::Water(_) => self.on_mean_surface(scene, x, y, width, height),
+            CameraHit::Light(_) | CameraHit::Other => None,
         }
-        let origin = scene.camera.position;
-        let dir = scene.camera.direction(x, y, width, height);
-        let (p, _) = self.surface.hit(origin, dir)?;
-        let n = self.surface.normal;
-        Some(WaterPoint {
-            start: p + n * surface_offset(p),
-            wo: -dir,
-            normal: n,
-            face: n,
-            clear: self.surface.crest,
-        })
+    }
+
+    fn water_points(
+        &self,
+        scene: &Scene,
+        positions: &[Vec2],
+        width: u32,
+        height: u32,
+        points: &mut [Option<WaterPoint>],
+    ) {
+        camera_water_points(scene, positions, width, height, points);
+        for (p, point) in positions.iter().zip(points) {
+            if point.is_some() {
+                *point = self.on_mean_surface(scene, p.x, p.y, width, height);
+            }
+        }
     }
 
     #[inline]

@@ -156,17 +156,21 @@ pub(super) fn trace_recorded(
             let mut gauss: Option<Vec<LobeGaussian>> = None;
             let inv_c = 1.0 / CAMERA_STRATA as f32;
             let inv_grid = 1.0 / (lobe * CAMERA_STRATA) as f32;
+            // The pixel's camera rays first: where each is drawn in the stream, its stratum
+            // offsets, and the generator as its lobe samples find it (each camera ray's
+            // numbers come in one run: its position, then its lobe samples'). Traced
+            // together, as the pixel's rays run close together.
             let mut offsets: Vec<u32> = (0..CAMERA_STRATA * CAMERA_STRATA).collect();
-            for (cs, half_sign) in (0..2 * CAMERA_STRATA * CAMERA_STRATA).map(|i| {
-                (
-                    i % (CAMERA_STRATA * CAMERA_STRATA),
-                    if i < CAMERA_STRATA * CAMERA_STRATA {
-                        1.0
-                    } else {
-                        -1.0
-                    },
-                )
-            }) {
+            let rays_per_pixel = (2 * CAMERA_STRATA * CAMERA_STRATA) as usize;
+            let mut camera = Vec::with_capacity(rays_per_pixel);
+            let mut positions = Vec::with_capacity(rays_per_pixel);
+            for i in 0..2 * CAMERA_STRATA * CAMERA_STRATA {
+                let cs = i % (CAMERA_STRATA * CAMERA_STRATA);
+                let half_sign = if i < CAMERA_STRATA * CAMERA_STRATA {
+                    1.0
+                } else {
+                    -1.0
+                };
                 if cs == 0 {
                     shuffle(&mut offsets, &mut rng);
                 }
@@ -176,16 +180,21 @@ pub(super) fn trace_recorded(
                 );
                 let fx = ((cs % CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
                 let fy = ((cs / CAMERA_STRATA) as f32 + rng.next_f32()) * inv_c;
-                let Some(water) =
-                    water_model.water_point(scene, x as f32 + fx, y as f32 + fy, width, height)
-                else {
+                positions.push(Vec2::new(x as f32 + fx, y as f32 + fy));
+                camera.push((ox, oy, half_sign, rng.clone()));
+                // Past this ray's lobe numbers, drawn whatever it hits.
+                for _ in 0..lobe * lobe {
+                    rng.next_f32();
+                    rng.next_f32();
+                }
+            }
+            let mut points = vec![None; positions.len()];
+            let (mut drawn, mut wis, mut tmaxes, mut reflected) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            water_model.water_points(scene, &positions, width, height, &mut points);
+            for ((ox, oy, half_sign, mut rng), water) in camera.into_iter().zip(points) {
+                let Some(water) = water else {
                     missed_water += 1;
-                    // Draw the lobe numbers anyway, so that every camera ray of a pixel uses
-                    // the same stream positions whatever the others hit.
-                    for _ in 0..lobe * lobe {
-                        rng.next_f32();
-                        rng.next_f32();
-                    }
                     continue;
                 };
                 // Its place among the pixel's recorded camera rays (each met the water).
@@ -205,6 +214,9 @@ pub(super) fn trace_recorded(
                         .map(|plane| LobeGaussian::matched(plane, water.start, &dirs, count))
                         .collect()
                 });
+                // The camera ray's lobe samples that may land in a region of interest, then
+                // their rays traced together (they leave one point), then each one stored.
+                drawn.clear();
                 for ls in 0..lobe * lobe {
                     let grid_u = Vec2::new(
                         (((ls % lobe) * CAMERA_STRATA + ox) as f32 + rng.next_f32()) * inv_grid,
@@ -229,8 +241,16 @@ pub(super) fn trace_recorded(
                     };
                     // A thousandth further: a face's triangles lie within a ten-thousandth
                     // of the distance of its plane.
-                    let tmax = reach * 1.001;
-                    let hit = water.reflected_hit(scene, s.wi, tmax);
+                    drawn.push((grid_u, s, reach * 1.001));
+                }
+                wis.clear();
+                wis.extend(drawn.iter().map(|d| d.1.wi));
+                tmaxes.clear();
+                tmaxes.extend(drawn.iter().map(|d| d.2));
+                reflected.clear();
+                reflected.resize(drawn.len(), None);
+                water.reflected_hits(scene, &wis, &tmaxes, &mut reflected);
+                for (&(grid_u, s, _), &hit) in drawn.iter().zip(&reflected) {
                     let mut lobe_cell = None;
                     for (k, plane) in planes.iter().enumerate() {
                         let g = &gauss[k];
