@@ -145,6 +145,29 @@ pub fn surface_offset(p: Vec3) -> f32 {
     1e-5 * (1.0 + p.abs().max_element())
 }
 
+/// [`WaterPoint::reflected_hit`] of ray `i` leaving `points[i]` in direction `wi[i]` within
+/// `tmax[i]`, into `hits[i]` (all as long as `points`). The exact model's rays, which leave
+/// nearby points in nearly one direction when the points are a pixel's, are traced in
+/// packets ([`crate::tracing::Tracer::closest_hits_from`]).
+pub fn reflected_hits_of(
+    scene: &Scene,
+    points: &[WaterPoint],
+    wi: &[Vec3],
+    tmax: &[f32],
+    hits: &mut [Option<Hit>],
+) {
+    if points.iter().all(|p| p.clear == 0.0) {
+        let origins: Vec<Vec3> = points.iter().map(|p| p.start).collect();
+        scene
+            .tracer
+            .closest_hits_from(&origins, wi, 0.0, tmax, hits);
+    } else {
+        for (((point, &wi), &tmax), hit) in points.iter().zip(wi).zip(tmax).zip(hits) {
+            *hit = point.reflected_hit(scene, wi, tmax);
+        }
+    }
+}
+
 /// Where a camera ray meets the water, with what its reflected rays need.
 #[derive(Clone, Copy, Debug)]
 pub struct WaterPoint {

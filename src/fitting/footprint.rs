@@ -6,12 +6,14 @@
 use glam::Vec2;
 use rayon::prelude::*;
 
-use super::light_plane::{reflected_sample, LightPlane};
+use super::light_plane::{jittered, LightPlane};
 use super::rect::Rect;
 use super::PIXELS_PER_TASK;
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
+use crate::render::reflected_hits_of;
 use crate::scene_in::Scene;
+use crate::tracing::PACKET_RAYS;
 use crate::water_model::{ExactSurface, WaterModel};
 
 /// Stream tag of the footprints' random numbers: distinct from the renderer's (which uses the
@@ -180,37 +182,70 @@ pub fn footprint_with(
         ..Default::default()
     };
     let side = 2 * radius + 1;
-    for _ in 0..samples {
-        // The box's pixels are equally likely: the mean of their values is modelled.
-        let (bx, by) = if radius == 0 {
-            (x, y)
-        } else {
-            let k = rng.next_u32() % (side * side);
-            (
-                (x + k % side).saturating_sub(radius),
-                (y + k / side).saturating_sub(radius),
-            )
-        };
-        let Some((water, sample)) =
-            reflected_sample(water_model, scene, model, bx, by, width, height, &mut rng)
-        else {
-            continue;
-        };
-        let start = water.start;
-        // A ray that cannot reach the plane cannot land on it: no need to trace it, and one
-        // that can need not look beyond it (a thousandth further: the face's triangles lie
-        // within a ten-thousandth of the distance of its plane).
-        let Some(t_plane) = plane.distance(start, sample.wi) else {
-            continue;
-        };
-        // Area lights already in the scene are not geometry and do not occlude: the fit asks
-        // what a light on the plane would show, and an existing light coplanar with its wall
-        // must not hide the wall (it would, by rounding, for about half the rays). The bound
-        // lets the traversal skip everything beyond the plane.
-        if let Some(hit) = water.reflected_hit(scene, sample.wi, t_plane * 1.001) {
-            if plane.contains_triangle(scene, hit.triangle) {
-                fp.points.push(plane.coords(start + sample.wi * hit.t));
-                fp.weights.push(sample.weight);
+    // The samples in runs of a packet: their numbers drawn in order (each sample's box
+    // pixel, jitter and lobe pair, whatever it hits), their camera rays traced together, then
+    // their reflected rays, which leave the pixel's water in nearly one direction.
+    let mut positions = Vec::with_capacity(PACKET_RAYS);
+    let mut pairs = Vec::with_capacity(PACKET_RAYS);
+    let mut water = [None; PACKET_RAYS];
+    let (mut points, mut wis, mut limits) = (Vec::new(), Vec::new(), Vec::new());
+    let mut lobe = Vec::with_capacity(PACKET_RAYS);
+    let mut hits = [None; PACKET_RAYS];
+    let mut left = samples as usize;
+    while left > 0 {
+        let n = left.min(PACKET_RAYS);
+        left -= n;
+        positions.clear();
+        pairs.clear();
+        for _ in 0..n {
+            // The box's pixels are equally likely: the mean of their values is modelled.
+            let (bx, by) = if radius == 0 {
+                (x, y)
+            } else {
+                let k = rng.next_u32() % (side * side);
+                (
+                    (x + k % side).saturating_sub(radius),
+                    (y + k / side).saturating_sub(radius),
+                )
+            };
+            let (jx, jy) = jittered(bx, by, &mut rng);
+            positions.push(Vec2::new(jx, jy));
+            pairs.push(Vec2::new(rng.next_f32(), rng.next_f32()));
+        }
+        water_model.water_points(scene, &positions, width, height, &mut water[..n]);
+        points.clear();
+        wis.clear();
+        limits.clear();
+        lobe.clear();
+        for (water, &u) in water[..n].iter().zip(&pairs) {
+            let Some(water) = water else {
+                continue;
+            };
+            let Some(sample) = water_model.reflect(water, model, u) else {
+                continue;
+            };
+            // A ray that cannot reach the plane cannot land on it: no need to trace it, and
+            // one that can need not look beyond it (a thousandth further: the face's
+            // triangles lie within a ten-thousandth of the distance of its plane). Area
+            // lights already in the scene are not geometry and do not occlude: the fit asks
+            // what a light on the plane would show, and an existing light coplanar with its
+            // wall must not hide the wall (it would, by rounding, for about half the rays).
+            let Some(t_plane) = plane.distance(water.start, sample.wi) else {
+                continue;
+            };
+            points.push(*water);
+            wis.push(sample.wi);
+            limits.push(t_plane * 1.001);
+            lobe.push(sample.weight);
+        }
+        let hits = &mut hits[..points.len()];
+        reflected_hits_of(scene, &points, &wis, &limits, hits);
+        for (((water, wi), weight), hit) in points.iter().zip(&wis).zip(&lobe).zip(hits.iter()) {
+            if let Some(hit) = hit {
+                if plane.contains_triangle(scene, hit.triangle) {
+                    fp.points.push(plane.coords(water.start + *wi * hit.t));
+                    fp.weights.push(*weight);
+                }
             }
         }
     }

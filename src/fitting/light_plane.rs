@@ -289,10 +289,17 @@ pub fn reflected_sample(
     height: u32,
     rng: &mut Rng,
 ) -> Option<(WaterPoint, crate::optics::LobeSample)> {
-    let jx = x as f32 + rng.next_f32();
-    let jy = y as f32 + rng.next_f32();
+    let (jx, jy) = jittered(x, y, rng);
     let u = Vec2::new(rng.next_f32(), rng.next_f32());
     let water = water_model.water_point(scene, jx, jy, width, height)?;
     let sample = water_model.reflect(&water, model, u)?;
     Some((water, sample))
+}
+
+/// A uniform point of pixel (`x`, `y`), in pixel units: the first two numbers a
+/// [`reflected_sample`] draws.
+pub(crate) fn jittered(x: u32, y: u32, rng: &mut Rng) -> (f32, f32) {
+    let jx = x as f32 + rng.next_f32();
+    let jy = y as f32 + rng.next_f32();
+    (jx, jy)
 }

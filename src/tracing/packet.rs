@@ -1,4 +1,5 @@
-//! Rays from one origin traced together: a pixel's camera rays, a row's centre rays.
+//! Rays that run close together traced together: a pixel's camera rays, a row's centre
+//! rays, a water point's reflected rays.
 //!
 //! Each node of a compressed wide BVH stores its eight children's boxes quantised to bytes,
 //! and turning them back into numbers is most of what testing a ray against a node costs
@@ -179,13 +180,35 @@ impl Tracer {
             .zip(tmax.chunks(PACKET_RAYS))
             .zip(hits.chunks_mut(PACKET_RAYS))
         {
-            self.closest_hits_of_packet(origin, dirs, tmin, tmax, hits);
+            self.closest_hits_of_packet(|_| origin, dirs, tmin, tmax, hits);
         }
     }
 
+    /// [`Tracer::closest_hits`] of rays with origins of their own, `origins[i] + t dirs[i]`
+    /// (`origins` as long as `dirs`): rays that leave points close together in nearly one
+    /// direction (the reflected rays of a pixel's camera rays) still run close together.
+    pub fn closest_hits_from(
+        &self,
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        tmin: f32,
+        tmax: &[f32],
+        hits: &mut [Option<Hit>],
+    ) {
+        for (((origins, dirs), tmax), hits) in origins
+            .chunks(PACKET_RAYS)
+            .zip(dirs.chunks(PACKET_RAYS))
+            .zip(tmax.chunks(PACKET_RAYS))
+            .zip(hits.chunks_mut(PACKET_RAYS))
+        {
+            self.closest_hits_of_packet(|r| origins[r], dirs, tmin, tmax, hits);
+        }
+    }
+
+    /// At most [`PACKET_RAYS`] rays, ray `r` leaving `origin(r)`.
     fn closest_hits_of_packet(
         &self,
-        origin: Vec3,
+        origin: impl Fn(usize) -> Vec3,
         dirs: &[Vec3],
         tmin: f32,
         tmax: &[f32],
@@ -197,13 +220,13 @@ impl Tracer {
         };
         let len = dirs.len().min(tmax.len()).min(PACKET_RAYS);
         let mut packet = Packet {
-            rays: [Ray::new(origin.into(), Vec3A::X, tmin, 0.0); PACKET_RAYS],
+            rays: [Ray::new(Vec3A::ZERO, Vec3A::X, tmin, 0.0); PACKET_RAYS],
             wrays: [const { None }; PACKET_RAYS],
             len,
         };
         let mut limits = [0.0; PACKET_RAYS];
         for (r, (&dir, &tmax)) in dirs.iter().zip(tmax).take(len).enumerate() {
-            let dir = nudge_direction(dir);
+            let (origin, dir) = (origin(r), nudge_direction(dir));
             packet.rays[r] = Ray::new(origin.into(), dir.into(), tmin, tmax);
             packet.wrays[r] = Some(WatertightRay::new(origin, dir));
             limits[r] = tmax;
@@ -325,8 +348,9 @@ mod tests {
     }
 
     /// Packets of rays close together (a pixel's camera rays, grazing the waves from above)
-    /// and far apart (a water point's reflected rays, every direction): each ray's hit is
-    /// the one it gets alone, to the bit, and the one testing every triangle finds.
+    /// and far apart (a water point's reflected rays, every direction), from one point and
+    /// from points of their own: each ray's hit is the one it gets alone, to the bit, and the
+    /// one testing every triangle finds.
     #[test]
     fn each_ray_of_a_packet_gets_its_own_closest_hit() {
         let n = 96;
@@ -369,9 +393,25 @@ mod tests {
                         }
                     })
                     .collect();
+                // Every third packet from points of its own, a few centimetres apart.
+                let origins: Vec<Vec3> = (0..dirs.len())
+                    .map(|r| {
+                        if packet % 3 == 1 {
+                            origin + 0.05 * unit(&mut rng) * (r % 3) as f32
+                        } else {
+                            origin
+                        }
+                    })
+                    .collect();
                 let mut hits = vec![None; dirs.len()];
-                tracer.closest_hits(origin, &dirs, 0.0, &tmax, &mut hits);
-                for ((dir, hit), &tmax) in dirs.iter().zip(&hits).zip(&tmax) {
+                if packet % 3 == 1 {
+                    tracer.closest_hits_from(&origins, &dirs, 0.0, &tmax, &mut hits);
+                } else {
+                    tracer.closest_hits(origin, &dirs, 0.0, &tmax, &mut hits);
+                }
+                for (((dir, hit), &tmax), &origin) in
+                    dirs.iter().zip(&hits).zip(&tmax).zip(&origins)
+                {
                     let alone = tracer.closest_hit(origin, *dir, 0.0, tmax);
                     assert_eq!(*hit, alone, "packet {packet}, ray {dir}");
                     let brute = tracer.closest_hit_brute_force(origin, *dir, 0.0, tmax);
