@@ -4,7 +4,7 @@
 
 /// A PCG32 generator (O'Neill 2014, XSH-RR output): small, fast and statistically sound for
 /// Monte Carlo work.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Rng {
     state: u64,
     increment: u64,

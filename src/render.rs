@@ -24,6 +24,8 @@ use crate::tracing::{Hit, PACKET_RAYS};
 use crate::water_model::WaterModel;
 use crate::{Error, Result};
 
+mod pixels;
+
 /// How to render.
 #[derive(Clone, Debug)]
 pub struct RenderOptions<'a> {
@@ -269,6 +271,7 @@ impl WaterPoint {
 }
 
 /// What a camera ray sees first.
+#[derive(Clone, Copy, Debug)]
 pub enum CameraHit {
     /// Area light `index`, directly.
     Light(usize),
@@ -401,36 +404,57 @@ pub fn render_with_lights(
         .enumerate()
         .for_each(|(y, row)| {
             let mut row_reflected = 0u64;
+            let environment = options.environment.filter(|e| !e.is_black());
+            let camera_rays = camera_rays_per_pixel(options.samples_per_pixel);
+            let lobe_samples = options.samples_per_pixel / camera_rays;
+            let strata = (camera_rays as f32).sqrt() as u32;
             for (x, out) in row.iter_mut().enumerate() {
                 let index = y as u64 * w as u64 + x as u64;
                 let mut rng = Rng::new(options.seed, index);
-                let mut sum = [0f64; 3];
-                let camera_rays = camera_rays_per_pixel(options.samples_per_pixel);
-                let lobe_samples = options.samples_per_pixel / camera_rays;
-                let strata = (camera_rays as f32).sqrt() as u32;
-                for k in 0..camera_rays {
-                    let (value, traced) = pixel_sample(
-                        scene,
-                        lights,
-                        &model,
-                        options.water,
-                        options.environment.filter(|e| !e.is_black()).as_ref(),
-                        PixelSample {
-                            x: x as u32,
-                            y: y as u32,
-                            stratum: k,
-                            strata,
-                            lobe_samples,
-                        },
-                        w,
-                        h,
-                        &mut rng,
-                    );
-                    row_reflected += traced as u64;
-                    for c in 0..3 {
-                        sum[c] += value[c] as f64;
+                let sum = match environment.as_ref() {
+                    // Under a black night the pixel's camera rays go in packets.
+                    None => {
+                        let (sum, traced) = pixels::black_night_pixel(
+                            scene,
+                            lights,
+                            &model,
+                            options.water,
+                            (x as u32, y as u32),
+                            (camera_rays, lobe_samples),
+                            (w, h),
+                            &mut rng,
+                        );
+                        row_reflected += traced;
+                        sum
                     }
-                }
+                    Some(environment) => {
+                        let mut sum = [0f64; 3];
+                        for k in 0..camera_rays {
+                            let (value, traced) = pixel_sample(
+                                scene,
+                                lights,
+                                &model,
+                                options.water,
+                                Some(environment),
+                                PixelSample {
+                                    x: x as u32,
+                                    y: y as u32,
+                                    stratum: k,
+                                    strata,
+                                    lobe_samples,
+                                },
+                                w,
+                                h,
+                                &mut rng,
+                            );
+                            row_reflected += traced as u64;
+                            for c in 0..3 {
+                                sum[c] += value[c] as f64;
+                            }
+                        }
+                        sum
+                    }
+                };
                 let scale = options.exposure as f64 / camera_rays as f64;
                 *out = sum.map(|s| (s * scale) as f32);
             }
@@ -491,14 +515,49 @@ fn pixel_sample(
     h: u32,
     rng: &mut Rng,
 ) -> ([f32; 3], u32) {
-    let (mut fx, mut fy) = (rng.next_f32(), rng.next_f32());
-    if s.stratum < s.strata * s.strata {
-        let n = s.strata as f32;
-        fx = ((s.stratum % s.strata) as f32 + fx) / n;
-        fy = ((s.stratum / s.strata) as f32 + fy) / n;
+    let (x, y) = s.jittered(rng);
+    let hit = camera_hit(scene, lights, x, y, w, h);
+    shade(
+        scene,
+        lights,
+        model,
+        water_model,
+        environment,
+        (x, y, hit),
+        s.lobe_samples,
+        (w, h),
+        rng,
+    )
+}
+
+impl PixelSample {
+    /// Where in the image its camera ray goes: the first two numbers it draws.
+    fn jittered(&self, rng: &mut Rng) -> (f32, f32) {
+        let (mut fx, mut fy) = (rng.next_f32(), rng.next_f32());
+        if self.stratum < self.strata * self.strata {
+            let n = self.strata as f32;
+            fx = ((self.stratum % self.strata) as f32 + fx) / n;
+            fy = ((self.stratum / self.strata) as f32 + fy) / n;
+        }
+        (self.x as f32 + fx, self.y as f32 + fy)
     }
-    let (x, y) = (s.x as f32 + fx, s.y as f32 + fy);
-    let water = match camera_hit(scene, lights, x, y, w, h) {
+}
+
+/// The value of a camera ray through image position (`x`, `y`) that sees `hit` first, and
+/// how many reflected rays it traced: the rest of [`pixel_sample`] after the camera ray.
+#[allow(clippy::too_many_arguments)]
+fn shade(
+    scene: &Scene,
+    lights: &[AreaLight],
+    model: &ReflectionModel,
+    water_model: Option<&dyn WaterModel>,
+    environment: Option<&Environment>,
+    (x, y, hit): (f32, f32, CameraHit),
+    lobe_samples: u32,
+    (w, h): (u32, u32),
+    rng: &mut Rng,
+) -> ([f32; 3], u32) {
+    let water = match hit {
         CameraHit::Light(i) => return (lights[i].radiance, 0),
         CameraHit::Other => {
             let seen = environment.map_or([0.0; 3], |env| {
@@ -520,7 +579,7 @@ fn pixel_sample(
     };
     let mut sum = [0f32; 3];
     let mut traced = 0;
-    for _ in 0..s.lobe_samples {
+    for _ in 0..lobe_samples {
         let u = Vec2::new(rng.next_f32(), rng.next_f32());
         let sample = match water_model {
             None => water.reflect(model, u),
@@ -542,6 +601,6 @@ fn pixel_sample(
             sum[c] += seen[c] * sample.weight;
         }
     }
-    let inv = 1.0 / s.lobe_samples as f32;
+    let inv = 1.0 / lobe_samples as f32;
     (sum.map(|c| c * inv), traced)
 }
