@@ -20,11 +20,13 @@ use crate::progress::Reporter;
 use crate::random::Rng;
 use crate::scene_in::{AreaLight, Scene};
 use crate::settings::Setting;
-use crate::tracing::{Hit, PACKET_RAYS};
+use crate::tracing::Hit;
 use crate::water_model::WaterModel;
 use crate::{Error, Result};
 
-mod pixels;
+mod packets;
+
+pub use packets::{camera_water_points, reflected_hits_of};
 
 /// How to render.
 #[derive(Clone, Debug)]
@@ -145,29 +147,6 @@ pub fn trace(scene: &Scene, lights: &[AreaLight], origin: Vec3, dir: Vec3, tmin:
 /// distance from the scene origin (f32 rounding grows with it).
 pub fn surface_offset(p: Vec3) -> f32 {
     1e-5 * (1.0 + p.abs().max_element())
-}
-
-/// [`WaterPoint::reflected_hit`] of ray `i` leaving `points[i]` in direction `wi[i]` within
-/// `tmax[i]`, into `hits[i]` (all as long as `points`). The exact model's rays, which leave
-/// nearby points in nearly one direction when the points are a pixel's, are traced in
-/// packets ([`crate::tracing::Tracer::closest_hits_from`]).
-pub fn reflected_hits_of(
-    scene: &Scene,
-    points: &[WaterPoint],
-    wi: &[Vec3],
-    tmax: &[f32],
-    hits: &mut [Option<Hit>],
-) {
-    if points.iter().all(|p| p.clear == 0.0) {
-        let origins: Vec<Vec3> = points.iter().map(|p| p.start).collect();
-        scene
-            .tracer
-            .closest_hits_from(&origins, wi, 0.0, tmax, hits);
-    } else {
-        for (((point, &wi), &tmax), hit) in points.iter().zip(wi).zip(tmax).zip(hits) {
-            *hit = point.reflected_hit(scene, wi, tmax);
-        }
-    }
 }
 
 /// Where a camera ray meets the water, with what its reflected rays need.
@@ -305,43 +284,6 @@ pub fn camera_hit(
     }
 }
 
-/// [`camera_hit`]'s water point, without lights, for each image position of `positions`
-/// (pixel units, fractional), into `points` (as long; `None` where the ray sees anything
-/// else first, or nothing). The rays are traced in packets ([`crate::tracing::Tracer::closest_hits`]):
-/// a pixel's camera rays run close together.
-pub fn camera_water_points(
-    scene: &Scene,
-    positions: &[Vec2],
-    width: u32,
-    height: u32,
-    points: &mut [Option<WaterPoint>],
-) {
-    let origin = scene.camera.position;
-    for (positions, points) in positions
-        .chunks(PACKET_RAYS)
-        .zip(points.chunks_mut(PACKET_RAYS))
-    {
-        let n = positions.len();
-        let mut dirs = [Vec3::ZERO; PACKET_RAYS];
-        for (dir, p) in dirs.iter_mut().zip(positions) {
-            *dir = scene.camera.direction(p.x, p.y, width, height);
-        }
-        let mut hits = [None; PACKET_RAYS];
-        scene.tracer.closest_hits(
-            origin,
-            &dirs[..n],
-            0.0,
-            &[f32::INFINITY; PACKET_RAYS][..n],
-            &mut hits[..n],
-        );
-        for ((point, hit), dir) in points.iter_mut().zip(&hits).zip(&dirs) {
-            *point = hit
-                .as_ref()
-                .and_then(|hit| water_point_of(scene, *dir, hit));
-        }
-    }
-}
-
 /// The water point of the camera ray in direction `dir` whose first hit is `hit`, or `None`
 /// when that is not the water.
 fn water_point_of(scene: &Scene, dir: Vec3, hit: &Hit) -> Option<WaterPoint> {
@@ -414,7 +356,7 @@ pub fn render_with_lights(
                 let sum = match environment.as_ref() {
                     // Under a black night the pixel's camera rays go in packets.
                     None => {
-                        let (sum, traced) = pixels::black_night_pixel(
+                        let (sum, traced) = packets::black_night_pixel(
                             scene,
                             lights,
                             &model,

@@ -1,8 +1,8 @@
-//! A pixel's camera rays traced in packets ([`crate::tracing::Tracer::closest_hits`]): they
-//! run close together, and most of a render's time is theirs (a reflected ray is traced only
-//! when it meets a light).
+//! Rays traced in packets ([`crate::tracing::Tracer::closest_hits`]): the camera rays of a
+//! pixel, and the reflected rays of a pixel's water points, which run close together.
 //!
-//! A camera ray's random numbers follow the ones before it in the pixel's stream, and how
+//! Most of a render's time is its camera rays' (a reflected ray is traced only when it meets
+//! a light). A camera ray's random numbers follow the ones before it in the pixel's stream, and how
 //! many those are depends on what each ray saw (a ray that meets the water draws its lobe
 //! samples, one that meets a wall draws nothing more). The packet guesses that every ray meets
 //! the water, traces the rays where that puts them, and keeps each result only while the
@@ -10,15 +10,16 @@
 //! next ray. From the first ray it did not hold for, the rest of the pixel is traced one ray
 //! at a time. So every pixel is the one tracing ray by ray gives, to the bit.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use super::{
-    nearest_light, pixel_sample, shade, water_point_of, CameraHit, PixelSample, LIGHT_TIE_MARGIN,
+    nearest_light, pixel_sample, shade, water_point_of, CameraHit, PixelSample, WaterPoint,
+    LIGHT_TIE_MARGIN,
 };
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
 use crate::scene_in::{AreaLight, Scene};
-use crate::tracing::PACKET_RAYS;
+use crate::tracing::{Hit, PACKET_RAYS};
 use crate::water_model::WaterModel;
 
 /// [`super::camera_hit`] for each image position of `positions` (pixel units), into `hits`
@@ -36,7 +37,7 @@ pub(super) fn camera_hits(
         .zip(hits.chunks_mut(PACKET_RAYS))
     {
         let n = positions.len();
-        let mut dirs = [glam::Vec3::ZERO; PACKET_RAYS];
+        let mut dirs = [Vec3::ZERO; PACKET_RAYS];
         let mut light = [None; PACKET_RAYS];
         let mut tmax = [f32::INFINITY; PACKET_RAYS];
         for r in 0..n {
@@ -59,6 +60,66 @@ pub(super) fn camera_hits(
                 (None, Some((i, _))) => CameraHit::Light(i),
                 (None, None) => CameraHit::Other,
             };
+        }
+    }
+}
+
+/// [`super::camera_hit`]'s water point, without lights, for each image position of `positions`
+/// (pixel units, fractional), into `points` (as long; `None` where the ray sees anything
+/// else first, or nothing). The rays are traced in packets ([`crate::tracing::Tracer::closest_hits`]):
+/// a pixel's camera rays run close together.
+pub fn camera_water_points(
+    scene: &Scene,
+    positions: &[Vec2],
+    width: u32,
+    height: u32,
+    points: &mut [Option<WaterPoint>],
+) {
+    let origin = scene.camera.position;
+    for (positions, points) in positions
+        .chunks(PACKET_RAYS)
+        .zip(points.chunks_mut(PACKET_RAYS))
+    {
+        let n = positions.len();
+        let mut dirs = [Vec3::ZERO; PACKET_RAYS];
+        for (dir, p) in dirs.iter_mut().zip(positions) {
+            *dir = scene.camera.direction(p.x, p.y, width, height);
+        }
+        let mut hits = [None; PACKET_RAYS];
+        scene.tracer.closest_hits(
+            origin,
+            &dirs[..n],
+            0.0,
+            &[f32::INFINITY; PACKET_RAYS][..n],
+            &mut hits[..n],
+        );
+        for ((point, hit), dir) in points.iter_mut().zip(&hits).zip(&dirs) {
+            *point = hit
+                .as_ref()
+                .and_then(|hit| water_point_of(scene, *dir, hit));
+        }
+    }
+}
+
+/// [`WaterPoint::reflected_hit`] of ray `i` leaving `points[i]` in direction `wi[i]` within
+/// `tmax[i]`, into `hits[i]` (all as long as `points`). The exact model's rays, which leave
+/// nearby points in nearly one direction when the points are a pixel's, are traced in
+/// packets ([`crate::tracing::Tracer::closest_hits_from`]).
+pub fn reflected_hits_of(
+    scene: &Scene,
+    points: &[WaterPoint],
+    wi: &[Vec3],
+    tmax: &[f32],
+    hits: &mut [Option<Hit>],
+) {
+    if points.iter().all(|p| p.clear == 0.0) {
+        let origins: Vec<Vec3> = points.iter().map(|p| p.start).collect();
+        scene
+            .tracer
+            .closest_hits_from(&origins, wi, 0.0, tmax, hits);
+    } else {
+        for (((point, &wi), &tmax), hit) in points.iter().zip(wi).zip(tmax).zip(hits) {
+            *hit = point.reflected_hit(scene, wi, tmax);
         }
     }
 }
