@@ -198,12 +198,28 @@ pub(super) fn direct_hits(
 ) -> Vec<Hit> {
     let origin = scene.camera.position;
     let inv_c = 1.0 / CAMERA_STRATA as f32;
+    let centre = |cs: u32| {
+        (
+            x as f32 + ((cs % CAMERA_STRATA) as f32 + 0.5) * inv_c,
+            y as f32 + ((cs / CAMERA_STRATA) as f32 + 0.5) * inv_c,
+        )
+    };
+    // The strata's rays traced together: they run close together.
+    let dirs: Vec<Vec3> = (0..DIRECT_RAYS)
+        .map(|cs| {
+            let (fx, fy) = centre(cs);
+            scene.camera.direction(fx, fy, width, height)
+        })
+        .collect();
+    let mut first = vec![None; dirs.len()];
+    let unlimited = vec![f32::INFINITY; dirs.len()];
+    scene
+        .tracer
+        .closest_hits(origin, &dirs, 0.0, &unlimited, &mut first);
     let mut hits = Vec::new();
-    for cs in 0..DIRECT_RAYS {
-        let fx = x as f32 + ((cs % CAMERA_STRATA) as f32 + 0.5) * inv_c;
-        let fy = y as f32 + ((cs / CAMERA_STRATA) as f32 + 0.5) * inv_c;
-        let dir = scene.camera.direction(fx, fy, width, height);
-        let Some(hit) = scene.tracer.closest_hit(origin, dir, 0.0, f32::INFINITY) else {
+    for ((cs, &dir), hit) in (0..DIRECT_RAYS).zip(&dirs).zip(first) {
+        let (fx, fy) = centre(cs);
+        let Some(hit) = hit else {
             continue;
         };
         for (k, (plane, r)) in planes.iter().zip(roi).enumerate() {
