@@ -150,7 +150,7 @@ pub fn surface_offset(p: Vec3) -> f32 {
 }
 
 /// Where a camera ray meets the water, with what its reflected rays need.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct WaterPoint {
     /// Origin of the reflected rays: the hit lifted off the surface on the camera's side.
     pub start: Vec3,

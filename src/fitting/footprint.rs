@@ -3,7 +3,7 @@
 //! pixel for any rectangle on the plane is then a sum over the samples inside it, so the
 //! radiance and edge searches never trace a ray.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::light_plane::{jittered, LightPlane};
@@ -11,7 +11,7 @@ use super::rect::Rect;
 use super::PIXELS_PER_TASK;
 use crate::optics::ReflectionModel;
 use crate::random::Rng;
-use crate::render::reflected_hits_of;
+use crate::render::{reflected_hits_of, WaterPoint};
 use crate::scene_in::Scene;
 use crate::tracing::PACKET_RAYS;
 use crate::water_model::{ExactSurface, WaterModel};
@@ -185,19 +185,19 @@ pub fn footprint_with(
     // The samples in runs of a packet: their numbers drawn in order (each sample's box
     // pixel, jitter and lobe pair, whatever it hits), their camera rays traced together, then
     // their reflected rays, which leave the pixel's water in nearly one direction.
-    let mut positions = Vec::with_capacity(PACKET_RAYS);
-    let mut pairs = Vec::with_capacity(PACKET_RAYS);
+    let mut positions = [Vec2::ZERO; PACKET_RAYS];
+    let mut pairs = [Vec2::ZERO; PACKET_RAYS];
     let mut water = [None; PACKET_RAYS];
-    let (mut points, mut wis, mut limits) = (Vec::new(), Vec::new(), Vec::new());
-    let mut lobe = Vec::with_capacity(PACKET_RAYS);
+    let mut points = [WaterPoint::default(); PACKET_RAYS];
+    let mut wis = [Vec3::ZERO; PACKET_RAYS];
+    let mut limits = [0.0f32; PACKET_RAYS];
+    let mut lobe = [0.0f32; PACKET_RAYS];
     let mut hits = [None; PACKET_RAYS];
     let mut left = samples as usize;
     while left > 0 {
         let n = left.min(PACKET_RAYS);
         left -= n;
-        positions.clear();
-        pairs.clear();
-        for _ in 0..n {
+        for j in 0..n {
             // The box's pixels are equally likely: the mean of their values is modelled.
             let (bx, by) = if radius == 0 {
                 (x, y)
@@ -209,14 +209,11 @@ pub fn footprint_with(
                 )
             };
             let (jx, jy) = jittered(bx, by, &mut rng);
-            positions.push(Vec2::new(jx, jy));
-            pairs.push(Vec2::new(rng.next_f32(), rng.next_f32()));
+            positions[j] = Vec2::new(jx, jy);
+            pairs[j] = Vec2::new(rng.next_f32(), rng.next_f32());
         }
-        water_model.water_points(scene, &positions, width, height, &mut water[..n]);
-        points.clear();
-        wis.clear();
-        limits.clear();
-        lobe.clear();
+        water_model.water_points(scene, &positions[..n], width, height, &mut water[..n]);
+        let mut m = 0;
         for (water, &u) in water[..n].iter().zip(&pairs) {
             let Some(water) = water else {
                 continue;
@@ -233,13 +230,14 @@ pub fn footprint_with(
             let Some(t_plane) = plane.distance(water.start, sample.wi) else {
                 continue;
             };
-            points.push(*water);
-            wis.push(sample.wi);
-            limits.push(t_plane * 1.001);
-            lobe.push(sample.weight);
+            points[m] = *water;
+            wis[m] = sample.wi;
+            limits[m] = t_plane * 1.001;
+            lobe[m] = sample.weight;
+            m += 1;
         }
-        let hits = &mut hits[..points.len()];
-        reflected_hits_of(scene, &points, &wis, &limits, hits);
+        let hits = &mut hits[..m];
+        reflected_hits_of(scene, &points[..m], &wis[..m], &limits[..m], hits);
         for (((water, wi), weight), hit) in points.iter().zip(&wis).zip(&lobe).zip(hits.iter()) {
             if let Some(hit) = hit {
                 if plane.contains_triangle(scene, hit.triangle) {

@@ -113,10 +113,19 @@ pub fn reflected_hits_of(
     hits: &mut [Option<Hit>],
 ) {
     if points.iter().all(|p| p.clear == 0.0) {
-        let origins: Vec<Vec3> = points.iter().map(|p| p.start).collect();
-        scene
-            .tracer
-            .closest_hits_from(&origins, wi, 0.0, tmax, hits);
+        for (((points, wi), tmax), hits) in points
+            .chunks(PACKET_RAYS)
+            .zip(wi.chunks(PACKET_RAYS))
+            .zip(tmax.chunks(PACKET_RAYS))
+            .zip(hits.chunks_mut(PACKET_RAYS))
+        {
+            let mut origins = [Vec3::ZERO; PACKET_RAYS];
+            for (origin, point) in origins.iter_mut().zip(points) {
+                *origin = point.start;
+            }
+            let origins = &origins[..points.len()];
+            scene.tracer.closest_hits_from(origins, wi, 0.0, tmax, hits);
+        }
     } else {
         for (((point, &wi), &tmax), hit) in points.iter().zip(wi).zip(tmax).zip(hits) {
             *hit = point.reflected_hit(scene, wi, tmax);

@@ -205,17 +205,15 @@ pub(super) fn direct_hits(
         )
     };
     // The strata's rays traced together: they run close together.
-    let dirs: Vec<Vec3> = (0..DIRECT_RAYS)
-        .map(|cs| {
-            let (fx, fy) = centre(cs);
-            scene.camera.direction(fx, fy, width, height)
-        })
-        .collect();
-    let mut first = vec![None; dirs.len()];
-    let unlimited = vec![f32::INFINITY; dirs.len()];
+    const N: usize = DIRECT_RAYS as usize;
+    let dirs: [Vec3; N] = std::array::from_fn(|cs| {
+        let (fx, fy) = centre(cs as u32);
+        scene.camera.direction(fx, fy, width, height)
+    });
+    let mut first = [None; N];
     scene
         .tracer
-        .closest_hits(origin, &dirs, 0.0, &unlimited, &mut first);
+        .closest_hits(origin, &dirs, 0.0, &[f32::INFINITY; N], &mut first);
     let mut hits = Vec::new();
     for ((cs, &dir), hit) in (0..DIRECT_RAYS).zip(&dirs).zip(first) {
         let (fx, fy) = centre(cs);
