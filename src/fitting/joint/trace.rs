@@ -340,39 +340,49 @@ fn in_store_order(
     lobes: Vec<SampleLobe>,
     planes: usize,
 ) -> (Vec<Hit>, Vec<SampleLobe>) {
-    let (mut hits, lobes) = if lobes.is_empty() {
-        let mut hits = hits;
-        hits.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
-        (hits, lobes)
+    // The same stable order for both: by u, ties in the order drawn.
+    let order = stable_order(hits.iter().map(|h| h.1.x));
+    let mut hits: Vec<Hit> = order.iter().map(|&i| hits[i as usize]).collect();
+    let lobes = if lobes.is_empty() {
+        lobes
     } else {
-        // The same stable order for both.
-        let mut order: Vec<usize> = (0..hits.len()).collect();
-        order.sort_by(|&a, &b| hits[a].1.x.total_cmp(&hits[b].1.x));
-        (
-            order.iter().map(|&i| hits[i]).collect(),
-            order.iter().map(|&i| lobes[i]).collect(),
-        )
+        order.iter().map(|&i| lobes[i as usize]).collect()
     };
-    // Every pixel's hits stay alive until all are stored: without the slack a growing vector
-    // keeps (up to as much again), the joint fit peaks lower.
-    hits.shrink_to_fit();
     let mut mine = Vec::new();
     for k in 0..planes {
         mine.clear();
         mine.extend((0..hits.len()).filter(|&q| hits[q].0 as usize == k));
-        // At most `super::MAX_JOINT_SAMPLES` per pixel (checked before the trace).
-        let mut order: Vec<u16> = (0..mine.len() as u16).collect();
-        order.sort_by(|&a, &b| {
-            hits[mine[a as usize]]
-                .1
-                .y
-                .total_cmp(&hits[mine[b as usize]].1.y)
-        });
+        // At most `super::MAX_JOINT_SAMPLES` per pixel (checked before the trace), so an
+        // entry fits in a u16.
+        let order = stable_order(mine.iter().map(|&q| hits[q].1.y));
         for (&q, v) in mine.iter().zip(order) {
-            hits[q].5 = v;
+            hits[q].5 = v as u16;
         }
     }
     (hits, lobes)
+}
+
+/// The indices of `values` in the order a stable sort by [`f32::total_cmp`] puts them:
+/// sorted as one integer each, the value's place in that order above its index, which
+/// keeps equal values in their order without a stable sort's comparisons through the list.
+fn stable_order(values: impl Iterator<Item = f32>) -> Vec<u32> {
+    let mut keys: Vec<u64> = values
+        .enumerate()
+        .map(|(i, v)| (total_order_key(v) as u64) << 32 | i as u64)
+        .collect();
+    keys.sort_unstable();
+    keys.into_iter().map(|k| k as u32).collect()
+}
+
+/// `v`'s place in [`f32::total_cmp`]'s order as an unsigned integer: a negative value's bits
+/// all flipped, a positive value's sign bit set (the map `total_cmp` itself compares by).
+fn total_order_key(v: f32) -> u32 {
+    let bits = v.to_bits();
+    if bits >> 31 == 1 {
+        !bits
+    } else {
+        bits | 1 << 31
+    }
 }
 
 /// Pixels apart in the interleaved order of [`interleaved`].
@@ -398,6 +408,36 @@ fn shuffle(items: &mut [u32], rng: &mut Rng) {
 mod tests {
     use super::super::fixture::table3_light0;
     use super::*;
+
+    /// The order of integer keys is a stable sort by `total_cmp`: values with many ties, of
+    /// both signs and both zeros, infinities and a NaN, against `sort_by`.
+    #[test]
+    fn the_keyed_order_is_the_stable_sort() {
+        let mut rng = Rng::new(3, 9);
+        let specials = [
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            1e-40,
+            -1e-40,
+        ];
+        for n in [0, 1, 2, 7, 64, 300] {
+            let values: Vec<f32> = (0..n)
+                .map(|i| {
+                    if i % 11 == 5 {
+                        specials[i % specials.len()]
+                    } else {
+                        ((rng.next_f32() * 9.0) as i32 - 4) as f32 * 0.25
+                    }
+                })
+                .collect();
+            let mut expected: Vec<u32> = (0..n as u32).collect();
+            expected.sort_by(|&a, &b| values[a as usize].total_cmp(&values[b as usize]));
+            assert_eq!(stable_order(values.iter().copied()), expected, "{n}");
+        }
+    }
 
     #[test]
     fn the_interleaved_order_visits_every_index_once() {
