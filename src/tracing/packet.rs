@@ -147,12 +147,12 @@ fn traverse(
             node_masks(node, state.oct_inv4, packet, active, tmax, &mut masks)
         },
         {
-            let bit = 1u32 << (state.primitive_id - base);
+            let shift = state.primitive_id - base;
+            // Bit r set where ray r's own mask holds the primitive (inactive rays' masks
+            // are 0).
             let mut rays = 0u8;
-            for (r, mask) in masks.iter().enumerate().take(packet.len) {
-                if mask & bit != 0 {
-                    rays |= 1 << r;
-                }
+            for (r, mask) in masks.iter().enumerate() {
+                rays |= (((mask >> shift) & 1) as u8) << r;
             }
             if rays != 0 {
                 leaf(state.primitive_id as usize, rays, tmax);
@@ -258,7 +258,10 @@ fn closest_in_packet(
     let mut found = [None::<(f32, u32)>; PACKET_RAYS];
     traverse(&built.bvh, packet, active, limits, |id, rays, limits| {
         let triangle = &built.ordered[id];
-        for r in (0..packet.len).filter(|r| rays & (1 << r) != 0) {
+        let mut left = rays;
+        while left != 0 {
+            let r = left.trailing_zeros() as usize;
+            left &= left - 1;
             let Some(wray) = &packet.wrays[r] else {
                 continue;
             };
