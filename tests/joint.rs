@@ -887,3 +887,80 @@ fn a_light_seen_whole_is_reported_and_can_be_held() {
     let ignored = fit(&[Some(higher), None], true);
     assert_eq!(ignored.lights, free.lights);
 }
+
+/// A light resumed near its optimum (`JointOptions::resume`) is descended from there, its
+/// edges searched a fraction of a pixel's footprint around it, and ends where the fit from
+/// the start ends: Table 1's light, resumed where the free fit put it, a third of a
+/// footprint (0.64 cm at the wall's 10 m) higher, and 3 cm (a footprint and a half) higher,
+/// beyond its first window, which the descent then walks, comes back to the free fit's
+/// rectangle within twice the descent's finest window (1 mm, a 3000th of the 3 m light) on
+/// every edge; after one sweep from the free fit's rectangle it is still there, while one
+/// sweep from the start leaves it further off. Held wins where both are given; `resume` of another length than the start
+/// lights is not used.
+#[test]
+fn a_light_resumed_near_its_optimum_ends_where_the_free_fit_does() {
+    let start = paper_start("table1.png");
+    let fit = |held: &[Option<streaklight::fitting::Rect>],
+               resume: &[Option<streaklight::fitting::Rect>]| {
+        start.fit(|o| JointOptions {
+            samples: 32,
+            held,
+            resume,
+            ..o
+        })
+    };
+    let free = fit(&[], &[]);
+    assert_eq!(free.lights.len(), 1);
+    let r = free.lights[0].rect();
+    let finest = 3.0 / 3000.0;
+    let higher = |dv: f32| streaklight::fitting::Rect {
+        v_min: r.v_min + dv,
+        v_max: r.v_max + dv,
+        ..r
+    };
+    for dv in [0.0, 0.0064, 0.03] {
+        let resumed = fit(&[], &[Some(higher(dv))]);
+        assert_eq!(resumed.lights.len(), 1);
+        let got = resumed.lights[0].rect();
+        for (a, b) in [
+            (got.u_min, r.u_min),
+            (got.u_max, r.u_max),
+            (got.v_min, r.v_min),
+            (got.v_max, r.v_max),
+        ] {
+            assert!((a - b).abs() <= 2.0 * finest, "{dv}: {got:?} against {r:?}");
+        }
+    }
+    // One sweep: resumed where the free fit ended, the light stays there; from the start
+    // it does not get there.
+    let one_sweep = |resume: &[Option<streaklight::fitting::Rect>]| {
+        start
+            .fit(|o| JointOptions {
+                samples: 32,
+                sweeps: 1,
+                resume,
+                ..o
+            })
+            .lights[0]
+            .rect()
+    };
+    let off = |got: streaklight::fitting::Rect| {
+        [
+            got.u_min - r.u_min,
+            got.u_max - r.u_max,
+            got.v_min - r.v_min,
+            got.v_max - r.v_max,
+        ]
+        .map(f32::abs)
+        .into_iter()
+        .fold(0.0, f32::max)
+    };
+    let (kept, from_start) = (off(one_sweep(&[Some(r)])), off(one_sweep(&[])));
+    eprintln!("one sweep: resumed {kept}, from the start {from_start}");
+    assert!(kept <= 2.0 * finest, "{kept}");
+    assert!(from_start > 2.0 * finest, "{from_start}");
+    let held = fit(&[Some(higher(0.1))], &[Some(higher(0.03))]);
+    assert_eq!(held.lights[0].rect(), higher(0.1));
+    let ignored = fit(&[], &[Some(higher(0.03)), None]);
+    assert_eq!(ignored.lights, free.lights);
+}

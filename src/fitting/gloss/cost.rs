@@ -30,7 +30,7 @@ pub(super) struct SearchFit<'a> {
 /// search visits from there. Costs are comparable only over the same pixels; with the region
 /// following each candidate's own lobe, a broader lobe could add faint pixels and with them
 /// cost (on the samples the streaks' boxes bound the region, so it did not change).
-fn region_gloss(options: &GlossSearch, start: f32) -> f32 {
+pub(super) fn region_gloss(options: &GlossSearch, start: f32) -> f32 {
     (start / 4.0).max(options.min_gloss)
 }
 

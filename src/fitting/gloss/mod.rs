@@ -81,8 +81,11 @@
 //! from a start 2 times off (`gloss1000.png` from 500) and 8 from one 2.5 times off
 //! (`gloss200.png` from 500, with 2 more made again on a second trace). On 2 cores a fit
 //! from the kept trace takes about 0.9 s, most of it the descent (a held one far less), and
-//! a trace about 1.3 s; then one full joint fit at the estimate (about 3.7 s): 7.3 s in all
-//! for Table 1, 16.5 s for `gloss200.png`.
+//! a trace about 1.3 s; then the final joint fit at the estimate. Where the fits on the last
+//! trace held every light and that trace serves the estimate, the final fit weighs it too,
+//! over the search's pixels and region, each light resumed where it was held (its edges
+//! searched a fraction of a footprint around it: [`JointOptions::resume`]); otherwise it is
+//! a fit of a given gloss from the start.
 //!
 //! # Uncertainty
 //!
@@ -110,8 +113,8 @@ pub(super) mod search;
 use std::time::Instant;
 
 use super::joint::{
-    fit_joint, place_starts, JointOptions, ModelledPixel, PixelShare, ProposalCache, Split,
-    Uncertainty,
+    fit_joint, place_starts, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache,
+    Reweight, Split, Uncertainty,
 };
 use super::{fit_paper, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
@@ -346,9 +349,21 @@ pub fn estimate_gloss(
     )?;
     // The kept trace is freed before the final fit traces its own: the peak memory is the
     // larger of the two, not their sum.
-    let (evaluations, failed, stopped) = {
+    // Where the fits on the kept trace held every light (each seen whole: its image pins
+    // it) and that trace serves the estimate, the final fit weighs it and resumes the lights
+    // where they were held (module doc); otherwise the trace is freed before the final fit
+    // traces its own: the peak memory is the larger of the two, not their sum.
+    let (evaluations, failed, stopped, kept) = {
         let done = cost;
-        (done.evaluations, done.failed, done.stopped)
+        let all_held = done
+            .held
+            .as_ref()
+            .is_some_and(|h| !h.is_empty() && h.iter().all(Option::is_some));
+        let serves = done.proposal.serves_traced(&Lobe::Exact {
+            gloss: found.x.exp() as f32,
+        });
+        let kept = (all_held && serves).then_some((done.proposal, done.held));
+        (done.evaluations, done.failed, done.stopped, kept)
     };
     if let Some(modelled) = stopped {
         timings.push((
@@ -401,22 +416,39 @@ pub fn estimate_gloss(
         .progress
         .stage(&format!("gloss search: final joint fit at e = {gloss:.0}"));
     let t = Instant::now();
-    let final_fit = fit_joint(
-        scene,
-        photo,
-        water,
-        streaks,
-        &paper.lights,
-        &JointOptions {
-            model: ReflectionModel {
-                gloss,
-                ..final_fit.model
-            },
-            // The gate was the search's first fit's to ask.
-            start_gate: None,
-            ..*final_fit
+    let at_estimate = JointOptions {
+        model: ReflectionModel {
+            gloss,
+            ..final_fit.model
         },
-    )?;
+        // The gate was the search's first fit's to ask.
+        start_gate: None,
+        ..*final_fit
+    };
+    let final_fit = match &kept {
+        // The search's pixels and region, which its trace was made for.
+        Some((cache, held)) => fit_joint(
+            scene,
+            photo,
+            water,
+            streaks,
+            &start,
+            &JointOptions {
+                pixels: options.search_pixels,
+                region_gloss: Some(cost::region_gloss(options, search_fit.model.gloss)),
+                close_regions: false,
+                starts_placed: true,
+                reweight: Some(Reweight {
+                    cache,
+                    target: Lobe::Exact { gloss },
+                }),
+                resume: held.as_deref().unwrap_or(&[]),
+                ..at_estimate
+            },
+        )?,
+        None => fit_joint(scene, photo, water, streaks, &paper.lights, &at_estimate)?,
+    };
+    drop(kept);
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
     let lights = final_fit.lights_with_statuses();
     warnings.extend(final_fit.warnings);

@@ -39,6 +39,10 @@ pub(super) fn first_window(r: &Rect, distance: f32) -> f32 {
 /// footprints.
 const IMAGE_FIRST_WINDOW: f32 = 2.0 * 1.732_050_8;
 
+/// The first half-window of such an edge of a light near its optimum already
+/// ([`Problem::descend_near`]), in the same units: half a bound, about 0.3 of a footprint.
+const NEAR_FIRST_WINDOW: f32 = 0.5;
+
 /// The least first window, as a share of the light's distance from the camera: 0.5 m at the
 /// harbour's 40 m (at the paper's 10 m, 12.5 cm: no light of its samples is that small).
 const FIRST_WINDOW_SHARE: f32 = 0.0125;
@@ -53,6 +57,20 @@ impl Problem {
     /// Coordinate descent over every free edge (see the module doc) for at most `sweeps`
     /// sweeps, stopping early once every search window has shrunk to its minimum.
     pub(super) fn descend(&self, st: &mut State, extents: &[Option<Rect>], sweeps: u32) {
+        self.descend_near(st, extents, sweeps, &[]);
+    }
+
+    /// [`Self::descend`], with the lights `near` marks (by light; missing: not near) taken
+    /// to lie within a fraction of a pixel's footprint of their optimum already: where their
+    /// direct image pins every edge, their first windows are [`NEAR_FIRST_WINDOW`] bounds
+    /// wide rather than [`IMAGE_FIRST_WINDOW`].
+    pub(super) fn descend_near(
+        &self,
+        st: &mut State,
+        extents: &[Option<Rect>],
+        sweeps: u32,
+        near: &[bool],
+    ) {
         // Initial half-windows: see `first_window`; a few pixel footprints for a light its
         // direct image pins on every side (`image_bounds`), which lies within about one of
         // its optimum already.
@@ -62,11 +80,17 @@ impl Problem {
             .iter()
             .zip(&st.set_of)
             .zip(&bounds)
-            .map(|((r, &set), bound)| {
+            .enumerate()
+            .map(|(k, ((r, &set), bound))| {
                 let wide = first_window(r, self.planes[set].distance);
+                let first = if near.get(k).copied().unwrap_or(false) {
+                    NEAR_FIRST_WINDOW
+                } else {
+                    IMAGE_FIRST_WINDOW
+                };
                 match bound {
                     [Some(l), Some(rt), Some(b), Some(t)] => {
-                        [*l, *rt, *b, *t].map(|s| (IMAGE_FIRST_WINDOW * s).min(wide))
+                        [*l, *rt, *b, *t].map(|s| (first * s).min(wide))
                     }
                     _ => [wide; 4],
                 }

@@ -358,7 +358,7 @@ pub fn fit_joint_with(
     let mut footprint_seconds = t0.elapsed().as_secs_f64();
     let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
     if let Some(gate) = options.start_gate {
-        let mut st = start_state(&problem, start, &extents, options.held);
+        let mut st = start_state(&problem, start, &extents, options.held, options.resume);
         problem.solve_radiance(&mut st);
         let modelled = problem.water_image(&st, given_scales);
         if !(gate.0)(&modelled) {
@@ -405,6 +405,7 @@ pub fn fit_joint_with(
         &|origin, draw| fresh_set(0, origin, draw),
         options.progress,
         options.held,
+        options.resume,
     );
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
@@ -466,7 +467,10 @@ pub fn fit_joint_with(
                 st.radiance.clone(),
             );
             problem.solve_radiance(&mut st);
-            problem.descend(&mut st, &extents, options.sweeps);
+            // Every light lies at the unweighted fit's optimum, within a fraction of a
+            // footprint of the weighted one where its image pins it.
+            let near = vec![true; st.rects.len()];
+            problem.descend_near(&mut st, &extents, options.sweeps, &near);
             scales = Some(s);
         }
     }

@@ -43,10 +43,18 @@ pub(super) fn optimise(
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     progress: Reporter<'_>,
     held: &[Option<Rect>],
+    resume: &[Option<Rect>],
 ) -> (State, State, Vec<Split>) {
-    let mut st = start_state(problem, start, extents, held);
+    let mut st = start_state(problem, start, extents, held, resume);
     let mut replay = st.clone();
-    problem.descend(&mut st, extents, sweeps);
+    let near: Vec<bool> = (0..start.len())
+        .map(|k| {
+            resume.len() == start.len()
+                && resume[k].is_some()
+                && !(held.len() == start.len() && held[k].is_some())
+        })
+        .collect();
+    problem.descend_near(&mut st, extents, sweeps, &near);
     let mut splits = Vec::new();
     // A light whose every edge its direct image pins (`image_bound`) is one lamp's image:
     // its reflections need no second light (lamps with images of their own start lights of
@@ -143,18 +151,25 @@ pub(super) fn start_state(
     start: &[FittedLight],
     extents: &[Option<Rect>],
     held: &[Option<Rect>],
+    resume: &[Option<Rect>],
 ) -> State {
-    let held = |k: usize| {
-        held.get(k)
+    let given = |rects: &[Option<Rect>], k: usize| {
+        rects
+            .get(k)
             .copied()
             .flatten()
-            .filter(|_| held.len() == start.len())
+            .filter(|_| rects.len() == start.len())
     };
+    let held = |k: usize| given(held, k);
     let rects: Vec<Rect> = start
         .iter()
         .zip(extents.iter())
         .enumerate()
-        .map(|(k, (l, e))| held(k).unwrap_or_else(|| e.map_or(l.rect(), |e| l.rect().clamp_to(&e))))
+        .map(|(k, (l, e))| {
+            held(k)
+                .or(given(resume, k))
+                .unwrap_or_else(|| e.map_or(l.rect(), |e| l.rect().clamp_to(&e)))
+        })
         .collect();
     // An edge no streak-edge pixel looks at is held, unless the photo shows it directly.
     let pinned = start

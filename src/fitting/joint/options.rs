@@ -95,6 +95,13 @@ pub struct JointOptions<'a> {
     /// ([`JointOutcome::seen_whole`](super::JointOutcome::seen_whole)). Used only when its
     /// length is the start lights' count; empty by default.
     pub held: &'a [Option<Rect>],
+    /// Rectangles to start lights at with their edges free, one entry per start light as the
+    /// fit takes them (as for [`held`](Self::held), which wins where both give one): a fit
+    /// that follows a search starts the lights a search fit saw whole where that fit put
+    /// them, and their descent searches a fraction of a pixel's footprint around them
+    /// (`Problem::descend_near`). Used only when its length is the
+    /// start lights' count; empty by default.
+    pub resume: &'a [Option<Rect>],
     /// The start lights are already where the direct view puts them
     /// ([`place_starts`](super::place_starts)): the fit takes them as they are. A search
     /// whose fits all start from the same lights places them once. Off by default.
@@ -150,6 +157,7 @@ impl JointOptions<'_> {
             reweight: None,
             start_gate: None,
             held: &[],
+            resume: &[],
             starts_placed: false,
             thin_seen_whole: false,
         }

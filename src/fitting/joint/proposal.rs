@@ -124,6 +124,12 @@ impl ProposalCache {
         target.same_surface(&self.proposal)
             && (0..2).all(|a| (lo * p[a]..=hi * p[a]).contains(&t[a]))
     }
+
+    /// Whether a fit under `target` would weigh a trace already made: [`Self::covers`], and
+    /// a fit has traced it.
+    pub fn serves_traced(&self, target: &Lobe) -> bool {
+        self.covers(target) && self.traced.get().is_some()
+    }
 }
 
 impl ProposalTrace {

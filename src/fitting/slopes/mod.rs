@@ -26,6 +26,9 @@
 //! every later fit holds it there ([`JointOptions::held`]) and solves only its radiance: over the
 //! harbour's lights in frame the search then took 2-3 s rather than 5-9 s, the lights the
 //! same to 0.1 %, the variances along within 1 % and across within 14 % (docs/decisions.md).
+//! Where the search held every light, the final fit at the estimate weighs the search's trace
+//! too, over its pixels, and resumes each light where it was held ([`JointOptions::resume`]):
+//! a weighting and a short descent instead of a trace and a descent from the start.
 //! When the final fit
 //! is weighted by the glitter's noise (`JointOptions::glitter_weights`), so is every fit of
 //! the search, all by the weights the first one measured, so that their costs still compare.
@@ -404,9 +407,6 @@ pub fn estimate_slopes(
             )),
         }
     }
-    // The kept trace is freed before the final fit traces its own: the peak memory is the
-    // larger of the two, not their sum.
-    drop(proposal);
     let evaluations: Vec<([f32; 2], f64)> = made.iter().map(|m| (m.0, m.1.s)).collect();
     timings.push((
         format!("slope search ({} evaluations)", evaluations.len()),
@@ -427,20 +427,54 @@ pub fn estimate_slopes(
     ));
     let t = Instant::now();
     let at = water_with_total(surface, variance);
-    let fit = fit_joint_with(
-        &at,
-        scene,
-        photo,
-        water,
-        streaks,
-        &paper_fit.lights,
-        &JointOptions {
-            model,
-            pixels: search_share.get().copied().unwrap_or(final_fit.pixels),
-            thin_seen_whole: false,
-            ..*final_fit
-        },
-    )?;
+    // Where the search held every light (each seen whole: its image pins it), the final fit
+    // weighs the search's own trace for its lobe, over the search's pixels, and resumes
+    // each light where the search's first fit put it: a search of a fraction of a footprint
+    // around it instead of a trace and a descent from the start (module doc). Otherwise it
+    // traces its own samples from the start, and the kept trace is freed first: the peak
+    // memory is the larger of the two, not their sum.
+    let target = Lobe::Statistical {
+        water: at,
+        gloss: model.gloss,
+    };
+    let resume = whole
+        .get()
+        .filter(|h| !h.is_empty() && h.iter().all(Option::is_some))
+        .map_or(&[][..], |h| &h[..]);
+    let kept = (!resume.is_empty() && proposal.serves_traced(&target)).then_some(proposal);
+    let common = JointOptions {
+        model,
+        pixels: search_share.get().copied().unwrap_or(final_fit.pixels),
+        thin_seen_whole: false,
+        ..*final_fit
+    };
+    let fit = match &kept {
+        Some(cache) => fit_joint_with(
+            &at,
+            scene,
+            photo,
+            water,
+            streaks,
+            &start,
+            &JointOptions {
+                region_water: Some(&broad),
+                starts_placed: true,
+                resume,
+                reweight: Some(Reweight { cache, target }),
+                ..common
+            },
+        )?,
+        None => fit_joint_with(
+            &at,
+            scene,
+            photo,
+            water,
+            streaks,
+            &paper_fit.lights,
+            &common,
+        )?,
+    };
+    drop(kept);
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
     warnings.extend(fit.warnings.iter().cloned());
     let area = correlation_area(
