@@ -425,15 +425,11 @@ pub fn estimate_gloss(
         start_gate: None,
         ..*final_fit
     };
-    let final_fit = match &kept {
+    let resumed;
+    let (from, fit_options) = match &kept {
         // The search's pixels and region, which its trace was made for.
-        Some((cache, held)) => fit_joint(
-            scene,
-            photo,
-            water,
-            streaks,
-            &start,
-            &JointOptions {
+        Some((cache, held)) => {
+            resumed = JointOptions {
                 pixels: options.search_pixels,
                 region_gloss: Some(cost::region_gloss(options, search_fit.model.gloss)),
                 close_regions: false,
@@ -444,10 +440,12 @@ pub fn estimate_gloss(
                 }),
                 resume: held.as_deref().unwrap_or(&[]),
                 ..at_estimate
-            },
-        )?,
-        None => fit_joint(scene, photo, water, streaks, &paper.lights, &at_estimate)?,
+            };
+            (&start[..], &resumed)
+        }
+        None => (&paper.lights[..], &at_estimate),
     };
+    let final_fit = fit_joint(scene, photo, water, streaks, from, fit_options)?;
     drop(kept);
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
     let lights = final_fit.lights_with_statuses();

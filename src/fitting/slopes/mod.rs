@@ -448,32 +448,21 @@ pub fn estimate_slopes(
         thin_seen_whole: false,
         ..*final_fit
     };
-    let fit = match &kept {
-        Some(cache) => fit_joint_with(
-            &at,
-            scene,
-            photo,
-            water,
-            streaks,
-            &start,
-            &JointOptions {
+    let resumed;
+    let (from, fit_options) = match &kept {
+        Some(cache) => {
+            resumed = JointOptions {
                 region_water: Some(&broad),
                 starts_placed: true,
                 resume,
                 reweight: Some(Reweight { cache, target }),
                 ..common
-            },
-        )?,
-        None => fit_joint_with(
-            &at,
-            scene,
-            photo,
-            water,
-            streaks,
-            &paper_fit.lights,
-            &common,
-        )?,
+            };
+            (&start[..], &resumed)
+        }
+        None => (&paper_fit.lights[..], &common),
     };
+    let fit = fit_joint_with(&at, scene, photo, water, streaks, from, fit_options)?;
     drop(kept);
     timings.push(("final joint fit".to_string(), t.elapsed().as_secs_f64()));
     warnings.extend(fit.warnings.iter().cloned());
