@@ -890,13 +890,12 @@ fn a_light_seen_whole_is_reported_and_can_be_held() {
 
 /// A light resumed near its optimum (`JointOptions::resume`) is descended from there, its
 /// edges searched a fraction of a pixel's footprint around it, and ends where the fit from
-/// the start ends: Table 1's light, resumed where the free fit put it, a third of a
-/// footprint (0.64 cm at the wall's 10 m) higher, and 3 cm (a footprint and a half) higher,
-/// beyond its first window, which the descent then walks, comes back to the free fit's
-/// rectangle within twice the descent's finest window (1 mm, a 3000th of the 3 m light) on
-/// every edge; after one sweep from the free fit's rectangle it is still there, while one
-/// sweep from the start leaves it further off. Held wins where both are given; `resume` of another length than the start
-/// lights is not used.
+/// the start ends: Table 1's light, resumed where the free fit put it and 3 cm (a footprint
+/// and a half) higher, where its image no longer bounds its top and bottom and they search
+/// wide, comes back to the free fit's rectangle within twice the descent's finest window
+/// (1 mm, a 3000th of the 3 m light) on every edge; after one sweep from the free fit's
+/// rectangle it is still there, while one sweep from the start leaves it further off. Held
+/// wins where both are given.
 #[test]
 fn a_light_resumed_near_its_optimum_ends_where_the_free_fit_does() {
     let start = paper_start("table1.png");
@@ -918,7 +917,7 @@ fn a_light_resumed_near_its_optimum_ends_where_the_free_fit_does() {
         v_max: r.v_max + dv,
         ..r
     };
-    for dv in [0.0, 0.0064, 0.03] {
+    for dv in [0.0, 0.03] {
         let resumed = fit(&[], &[Some(higher(dv))]);
         assert_eq!(resumed.lights.len(), 1);
         let got = resumed.lights[0].rect();
@@ -961,6 +960,4 @@ fn a_light_resumed_near_its_optimum_ends_where_the_free_fit_does() {
     assert!(from_start > 2.0 * finest, "{from_start}");
     let held = fit(&[Some(higher(0.1))], &[Some(higher(0.03))]);
     assert_eq!(held.lights[0].rect(), higher(0.1));
-    let ignored = fit(&[], &[Some(higher(0.03)), None]);
-    assert_eq!(ignored.lights, free.lights);
 }
