@@ -347,8 +347,6 @@ pub fn estimate_gloss(
         ("gloss", &|e| format!("{e:.0}")),
         &mut cost,
     )?;
-    // The kept trace is freed before the final fit traces its own: the peak memory is the
-    // larger of the two, not their sum.
     // Where the fits on the kept trace held every light (each seen whole: its image pins
     // it) and that trace serves the estimate, the final fit weighs it and resumes the lights
     // where they were held (module doc); otherwise the trace is freed before the final fit

@@ -99,8 +99,8 @@ pub struct JointOptions<'a> {
     /// fit takes them (as for [`held`](Self::held), which wins where both give one): a fit
     /// that follows a search starts the lights a search fit saw whole where that fit put
     /// them, and their descent searches a fraction of a pixel's footprint around them
-    /// (`Problem::descend_near`). Used only when its length is the
-    /// start lights' count; empty by default.
+    /// (`Problem::descend_near`). Used only when its length is the start lights' count;
+    /// empty by default.
     pub resume: &'a [Option<Rect>],
     /// The start lights are already where the direct view puts them
     /// ([`place_starts`](super::place_starts)): the fit takes them as they are. A search
