@@ -684,6 +684,7 @@ fn all_pixels_reads_the_whole_region() {
 /// bit (the same samples: only the side-by-side trial is left out); told "side by side", it
 /// never cuts the light the other way. Each long step of the split says what it does and
 /// counts its work: the ways tried, the new light's own trace, the boundary's candidates.
+/// Asked to end at its split (`JointOptions::end_at_split`), it reports that split and stops.
 #[test]
 fn a_known_split_is_tried_only_its_way() {
     use streaklight::fitting::joint::{Split, SplitWay};
@@ -774,6 +775,33 @@ fn a_known_split_is_tried_only_its_way() {
         other.splits.iter().all(|s| s.way == SplitWay::SideBySide),
         "{:?}",
         other.splits
+    );
+    // Asked to end at its first split (an overlap refit follows it), the fit reports the
+    // same split, says that it ends there, and makes no light: no second sample set, no
+    // boundary search, no descent after the split.
+    assert!(!free.ended_at_split);
+    let record = Record::default();
+    let ended = start.fit(|o| JointOptions {
+        samples: 32,
+        direct_view: false,
+        end_at_split: true,
+        progress: Reporter::new(&record),
+        ..o
+    });
+    assert!(ended.ended_at_split);
+    assert_eq!(ended.splits, free.splits);
+    assert!(ended.lights.is_empty() && ended.uncertainty.is_empty());
+    let stages = record.0.into_inner().unwrap();
+    let said = |prefix: &str| stages.iter().find(|(line, _)| line.starts_with(prefix));
+    assert!(
+        said("joint fit: the residual of light 0 is structured")
+            .is_some_and(|(line, _)| line.ends_with("to be made again with the split known")),
+        "{stages:#?}"
+    );
+    assert!(said("joint fit: searching where").is_none(), "{stages:#?}");
+    assert!(
+        said("joint fit: lights 0 and 1: descents").is_none(),
+        "{stages:#?}"
     );
 }
 

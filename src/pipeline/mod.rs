@@ -223,6 +223,7 @@ pub fn fit(
         modelled: Vec::new(),
         splits: Vec::new(),
         stopped_at_start: false,
+        ended_at_split: false,
         share: None,
     };
     let water_model = if observations.is_empty() {
@@ -292,6 +293,9 @@ struct Found {
     /// Whether the last joint fit ended at its start (its start gate said so): no light,
     /// and `modelled` is the start lights' expected image.
     stopped_at_start: bool,
+    /// Whether the last joint fit ended at its first split
+    /// ([`JointOptions::end_at_split`]): no light yet, the overlap refit follows.
+    ended_at_split: bool,
     /// Which pixels the last joint fit read (`None`: as its reading gives them).
     share: Option<PixelShare>,
 }
@@ -395,6 +399,7 @@ impl Run<'_> {
         found.splits = outcome.splits;
         found.share = Some(outcome.share);
         found.stopped_at_start = outcome.stopped_at_start;
+        found.ended_at_split = outcome.ended_at_split;
         found.warnings.extend(outcome.warnings);
         Ok(())
     }
@@ -411,8 +416,11 @@ impl Run<'_> {
             .stage(&format!("joint fit of {} light(s)", found.lights.len()));
         let start = std::mem::take(&mut found.lights);
         let options = self.joint_options(j, j.reading);
+        // Where lights that share a streak are fitted again, the first fit's work past its
+        // split would be thrown away: it ends there.
         let first = JointOptions {
             start_gate: gate,
+            end_at_split: j.overlap_refit.is_some(),
             ..options
         };
         self.joint(&ExactSurface, &start, &first, "joint", found)?;
@@ -435,7 +443,7 @@ impl Run<'_> {
         let Some(reading) = j.overlap_refit else {
             return Ok(());
         };
-        if !warnings::shares_a_streak(&found.lights, &found.seen()) {
+        if !found.ended_at_split && !warnings::shares_a_streak(&found.lights, &found.seen()) {
             return Ok(());
         }
         self.progress.stage(&format!(
@@ -448,6 +456,7 @@ impl Run<'_> {
             samples: reading.samples,
             pixels: reading.share(self.photo.len() as u64),
             known_splits: &known,
+            end_at_split: false,
             ..*options
         };
         found.reading = Some(reading);

@@ -402,12 +402,25 @@ pub fn fit_joint_with(
         options.sweeps,
         options.split,
         options.known_splits,
+        options.end_at_split,
         &|origin, draw| fresh_set(0, origin, draw),
         options.progress,
         options.held,
         options.resume,
     );
     let mut optimise_seconds = t1.elapsed().as_secs_f64();
+    if options.end_at_split && !splits.is_empty() {
+        return Ok(JointOutcome {
+            pixels: pixels.len(),
+            timings: vec![
+                ("footprints".into(), footprint_seconds),
+                ("optimise".into(), optimise_seconds),
+            ],
+            splits,
+            ended_at_split: true,
+            ..JointOutcome::empty(share)
+        });
+    }
     let mut repeats = vec![(first.rects.clone(), first.radiance.clone())];
     for repeat in 1..options.repeats {
         options.progress.stage(&format!(
@@ -589,6 +602,7 @@ pub fn fit_joint_with(
         splits,
         row_scales: scales,
         stopped_at_start: false,
+        ended_at_split: false,
         seen_whole,
     })
 }

@@ -29,7 +29,9 @@ use crate::progress::Reporter;
 /// the optimum and the state its last descent started from (the start, or the split lights
 /// after their boundary search): a repeat on other samples starts there (see
 /// [`Problem::replay`]), and the splits made. A light of `known` (split by a fit before, from
-/// the same start) is tried only the way that fit cut it. `progress` hears each split (so
+/// the same start) is tried only the way that fit cut it. With `end_at_split` the fit
+/// returns at its first accepted split, the two halves as the trial left them
+/// ([`super::JointOptions::end_at_split`]). `progress` hears each split (so
 /// that a fit announced with N lights that ends with more says why) and the count of
 /// boundary candidates descended.
 #[allow(clippy::too_many_arguments)]
@@ -40,6 +42,7 @@ pub(super) fn optimise(
     sweeps: u32,
     split: bool,
     known: &[Split],
+    end_at_split: bool,
     fresh: &dyn Fn(usize, u32) -> PlaneSamples,
     progress: Reporter<'_>,
     held: &[Option<Rect>],
@@ -92,12 +95,19 @@ pub(super) fn optimise(
             splits.push(Split { light: k, way });
             st = trial;
             let b = st.rects.len() - 1;
+            let next = if end_at_split {
+                "this fit ends here, to be made again with the split known".to_string()
+            } else {
+                format!("tracing light {b}'s own samples")
+            };
             progress.stage(&format!(
                 "joint fit: the residual of light {k} is structured, as where two lights' \
-                 reflections merge into one streak: split into lights {k} and {b}, {}; \
-                 tracing light {b}'s own samples",
+                 reflections merge into one streak: split into lights {k} and {b}, {}; {next}",
                 way.words()
             ));
+            if end_at_split {
+                return (st.clone(), st, splits);
+            }
             // The two lights of a split read independent samples: with one set shared, the
             // cost's noise along their common boundary has minima far from the truth
             // (BENCHMARKS.md, the stacked sample).

@@ -33,6 +33,13 @@ pub struct JointOptions<'a> {
     /// the way that fit cut it (an overlap refit over more samples saves the other way's
     /// trial). Empty by default.
     pub known_splits: &'a [Split],
+    /// End the fit as soon as it splits a light ([`JointOutcome::ended_at_split`]): the
+    /// caller fits again from the same start with the split known (an overlap refit over
+    /// more samples), so the split light's own samples, its boundary search and the descents
+    /// after it would be thrown away. Off by default.
+    ///
+    /// [`JointOutcome::ended_at_split`]: super::JointOutcome::ended_at_split
+    pub end_at_split: bool,
     /// The gloss whose lobe decides which pixels around the streaks are fitted (`None`: the
     /// model's). Fits under different glosses are comparable only over the same pixels, so a
     /// gloss search fixes it to the broadest lobe it will try.
@@ -144,6 +151,7 @@ impl JointOptions<'_> {
             pixels: PixelShare::Checkerboard,
             split: true,
             known_splits: &[],
+            end_at_split: false,
             region_gloss: None,
             region_water: None,
             repeats: 1,

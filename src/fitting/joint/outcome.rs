@@ -41,6 +41,10 @@ pub struct JointOutcome {
     /// [`JointOptions::start_gate`](super::JointOptions::start_gate) said: then it has no
     /// light, and `modelled` is the start lights' expected image.
     pub stopped_at_start: bool,
+    /// Whether the fit ended at its first split, as
+    /// [`JointOptions::end_at_split`](super::JointOptions::end_at_split) asked: then it has
+    /// no light, and [`splits`](Self::splits) holds that split.
+    pub ended_at_split: bool,
     /// By start light as the fit took them (after the starts are moved onto and split by the
     /// lamps' direct images): the fitted rectangle of each the photo shows whole, every edge
     /// pinned by its direct image within a pixel's footprint
@@ -66,6 +70,7 @@ impl JointOutcome {
             splits: Vec::new(),
             row_scales: None,
             stopped_at_start: false,
+            ended_at_split: false,
             seen_whole: Vec::new(),
         }
     }
