@@ -121,7 +121,7 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = super::values::count)]
     pub repeats: u32,
     /// Lobe samples per pixel of the joint fit, rounded to 8 b^2 (8, 32, 72, 128, 200, 288,
-    /// ...; default 72; the fits of --gloss auto's search read 128): the time grows with them
+    /// ...; default 72; the fits of the statistical water's slope search read 128): the time grows with them
     /// and the fit's own noise falls, until the photo's own noise is what is left. Without
     /// this option and --all-pixels, lights the fit finds sharing a streak are fitted again
     /// over every pixel with 128 samples; with either, they are not. 1 or more; typical

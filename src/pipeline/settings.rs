@@ -152,10 +152,10 @@ impl Default for JointSettings {
 }
 
 impl JointSettings {
-    /// Estimating the gloss with the default search (its fits read [`SEARCH_SAMPLES`](crate::fitting::gloss::SEARCH_SAMPLES)
-    /// samples: their costs are not to be trusted with fewer); the final fit at the estimate
-    /// reads [`DEFAULT_JOINT_SAMPLES`] over a checkerboard, as a fit of a given gloss does,
-    /// without a refit of lights that share a streak.
+    /// Estimating the gloss with the default search (its fits read
+    /// [`SEARCH_SAMPLES`](crate::fitting::gloss::SEARCH_SAMPLES) samples); the final fit at
+    /// the estimate reads [`DEFAULT_JOINT_SAMPLES`] over a checkerboard, as a fit of a given
+    /// gloss does, without a refit of lights that share a streak.
     pub fn estimating_gloss() -> Self {
         JointSettings {
             reading: Reading {

@@ -31,11 +31,17 @@ impl WaterModelUsed {
     }
 }
 
+/// Joint-fit samples per pixel of the slope search's fits: 128, with which every figure of
+/// the statistical model's accuracy was measured (the gloss search's 72 are not measured
+/// there).
+const SLOPE_SEARCH_SAMPLES: u32 = 128;
+
 /// The one-dimensional searches of the slope variances: in the logarithm of a variance
 /// (twice that of the lobe's width), so the gloss search's steps doubled.
 fn slope_search() -> GlossSearch {
     let gloss = GlossSearch::default();
     GlossSearch {
+        search_samples: SLOPE_SEARCH_SAMPLES,
         first_step_ln: 2.0 * gloss.first_step_ln,
         max_step_ln: 2.0 * gloss.max_step_ln,
         tolerance_ln: 2.0 * gloss.tolerance_ln,

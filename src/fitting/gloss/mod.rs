@@ -36,16 +36,16 @@
 //!   (`cost::PROPOSAL_BROADER`). When the search steps beyond, it traces again from around the
 //!   step and makes again, on the new trace, the points that trace serves: costs of
 //!   different traces differ in level by more than the curve changes near its minimum.
-//! * The fits use the joint fit's full samples per pixel. With fewer the cost is not to be
-//!   trusted: the edge search picks, among thousands of rectangles, ones whose coefficients'
-//!   estimated noise (which the cost subtracts) happens to be large, and with a wide lobe and
-//!   32 samples that wins outright (on `gloss200.png` at e = 100-125: a rectangle a sixth of
-//!   the true height, seven times too bright, with a cost below zero; at 72 samples, a cost at
-//!   e = 75 below that at 100). Rescoring such fits on independent samples removes that bias,
-//!   but at 32 samples the rescored cost is still too noisy: its minimum moved between 205 and
-//!   225 with the seed. At 128 samples the fit's own cost is smooth in `e` and its minimum
-//!   agrees with that of 512-sample rescoring (202 and 204 on `gloss200.png`), so the search
-//!   uses it as it is. A fit whose cost still comes out non-positive counts as no evidence
+//! * The fits read the joint fit's default samples per pixel ([`SEARCH_SAMPLES`]). Too few
+//!   and the cost is not to be trusted: the edge search picks, among thousands of
+//!   rectangles, ones whose coefficients' estimated noise (which the cost subtracts) happens
+//!   to be large, and with a wide lobe and 32 samples that wins outright (on `gloss200.png`
+//!   at e = 100-125: a rectangle a sixth of the true height, seven times too bright, with a
+//!   cost below zero). With the lobe's Gaussian as control variate, the starts placed on the
+//!   lamps' images and the lights seen whole held, 72 samples give the estimates that 128
+//!   give, within the seeds' scatter, from every start tried and without the direct view too
+//!   (docs/decisions.md), in two thirds of the time. A fit whose cost still comes out
+//!   non-positive counts as no evidence
 //!   (infinite cost). The fits of the search run fewer coordinate-descent sweeps than a
 //!   final fit ([`GlossSearch::search_sweeps`]): the cost at the optimum moves by 0.3 % and
 //!   uniformly across `e`.
@@ -93,10 +93,9 @@
 //! the cost by the residual variance per degree of freedom `s2`, so `sigma(ln e) = sqrt(s2 / k)`.
 //! That is the photo's statistical limit (pixel noise independent): it leaves out the model's
 //! own errors and the Monte Carlo noise of the fits, and is a lower bound. On the samples it
-//! is about 0.06 %, while the estimates (`tests/gloss.rs`) are 201.0 for e = 200, 502.7 for
-//! 500 and 983.4 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
-//! measured when the search was written). Read the estimate as good to a few percent. (With the joint
-//! fit's own default of 72 samples e = 200 came out 223: see [`SEARCH_SAMPLES`].)
+//! is about 0.06 %, while the estimates (`tests/gloss.rs`) are 201.5 for e = 200, 503.0 for
+//! 500 and 989.3 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
+//! measured when the search was written). Read the estimate as good to a few percent.
 //!
 //! # Limits
 //!
@@ -114,7 +113,7 @@ use std::time::Instant;
 
 use super::joint::{
     fit_joint, place_starts, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache,
-    Reweight, Split, Uncertainty,
+    Reweight, Split, Uncertainty, DEFAULT_JOINT_SAMPLES,
 };
 use super::{fit_paper, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
@@ -152,9 +151,9 @@ pub struct GlossSearch {
     pub search_pixels: PixelShare,
 }
 
-/// Joint-fit samples per pixel of the search and, by default, of the final fit (module doc:
-/// the cost is not to be trusted with fewer; the joint fit's own default is lower).
-pub const SEARCH_SAMPLES: u32 = 128;
+/// Joint-fit samples per pixel of the search: the joint fit's default, which the final fit
+/// reads too (module doc: fewer make the cost untrustworthy).
+pub const SEARCH_SAMPLES: u32 = DEFAULT_JOINT_SAMPLES;
 
 impl Default for GlossSearch {
     /// Search `e` in [50, 5000] from the start.
