@@ -92,7 +92,7 @@ use std::time::Instant;
 
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
-use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, StreakObservation};
+use crate::fitting::{FittedLight, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
@@ -153,7 +153,7 @@ use problem::{Problem, State};
 use region::{region, region_of_interest};
 use repeats::mean_and_spread;
 use samples::sample_extent;
-use uncertainty::{facing_edges, uncertainties, FACING_REASON};
+use uncertainty::uncertainties;
 
 /// Refines `start` (typically the paper's per-streak estimate) by fitting all lights together
 /// to every water pixel of their streaks and surroundings (see the module doc).
@@ -532,60 +532,12 @@ pub fn fit_joint_with(
     let variance = problem.residual_variance(&st);
     optimise_seconds += t2.elapsed().as_secs_f64();
     let modelled = problem.water_image(&st, scales.as_deref());
-    let facing = facing_edges(&problem, &st);
-    // By start light: the rectangle of each whose every edge its direct image pins within a
-    // pixel's footprint (`image_bound`), unless a split made two lights of it.
-    let mut seen_whole: Vec<Option<Rect>> = vec![None; start.len()];
-    for (k, u) in uncertainty.iter().enumerate() {
-        let origin = problem.set_origin[st.set_of[k]];
-        let alone =
-            (0..st.rects.len()).all(|j| j == k || problem.set_origin[st.set_of[j]] != origin);
-        if alone && u.image_bound.iter().all(Option::is_some) {
-            seen_whole[origin] = Some(st.rects[k]);
-        }
-    }
+    let seen_whole = outcome::seen_whole(&problem, &st, &uncertainty, start.len());
     for (k, u) in uncertainty.iter_mut().enumerate() {
         u.direct_pixels = problem.direct_pixels_inside(st.set_of[k], &st.rects[k]);
         u.radiance_seen = problem.sees_radiance(st.set_of[k], &st.rects[k], st.radiance[k]);
     }
-    let lights = (0..st.rects.len())
-        .map(|k| {
-            let origin = &start[problem.set_origin[st.set_of[k]]];
-            let (r, rad) = (st.rects[k], st.radiance[k]);
-            let direct = problem.direct_edge_pixels(st.set_of[k], &r);
-            let mut edges = origin.edges.clone();
-            for side in EdgeSide::ALL {
-                if facing[k][side] {
-                    edges[side] = EdgeStatus::Unconstrained {
-                        reason: FACING_REASON.into(),
-                        pixels: 0,
-                        unseen: false,
-                    };
-                }
-                // An edge the photo shows directly is constrained by the pixels it crosses,
-                // whatever the reflections say of it.
-                if direct[side] > 0 {
-                    let reflected = match edges[side] {
-                        EdgeStatus::Constrained { pixels } => pixels,
-                        EdgeStatus::Unconstrained { .. } => 0,
-                    };
-                    edges[side] = EdgeStatus::Constrained {
-                        pixels: reflected + direct[side],
-                    };
-                }
-            }
-            FittedLight {
-                streak_ids: origin.streak_ids.clone(),
-                plane: origin.plane.clone(),
-                u_min: r.u_min,
-                u_max: r.u_max,
-                v_min: r.v_min,
-                v_max: r.v_max,
-                radiance: rad.map(|c| c as f32),
-                edges,
-            }
-        })
-        .collect();
+    let lights = outcome::fitted_lights(&problem, &st, start);
     Ok(JointOutcome {
         lights,
         uncertainty,

@@ -1,8 +1,9 @@
 //! What a joint fit returns ([`JointOutcome`]).
 
-use super::uncertainty::{edge_statuses, Uncertainty};
+use super::problem::{Problem, State};
+use super::uncertainty::{edge_statuses, facing_edges, Uncertainty, FACING_REASON};
 use super::{ModelledPixel, PixelShare, Split};
-use crate::fitting::{FittedLight, Rect};
+use crate::fitting::{EdgeSide, EdgeStatus, FittedLight, Rect};
 use crate::progress::Reporter;
 
 /// The result of a joint fit.
@@ -100,4 +101,74 @@ impl JointOutcome {
             })
             .collect()
     }
+}
+
+/// By start light (of `starts`): the rectangle of each light of `st` whose every edge its
+/// direct image pins within a pixel's footprint (its `uncertainty`'s `image_bound`), unless a
+/// split made two lights of it ([`JointOutcome::seen_whole`]).
+pub(super) fn seen_whole(
+    problem: &Problem,
+    st: &State,
+    uncertainty: &[Uncertainty],
+    starts: usize,
+) -> Vec<Option<Rect>> {
+    let mut seen_whole: Vec<Option<Rect>> = vec![None; starts];
+    for (k, u) in uncertainty.iter().enumerate() {
+        let origin = problem.set_origin[st.set_of[k]];
+        let alone =
+            (0..st.rects.len()).all(|j| j == k || problem.set_origin[st.set_of[j]] != origin);
+        if alone && u.image_bound.iter().all(Option::is_some) {
+            seen_whole[origin] = Some(st.rects[k]);
+        }
+    }
+    seen_whole
+}
+
+/// The lights of `st`, each with its start light's streaks and plane (from `start`) and its
+/// edges' statuses: the start's, an edge facing another light of its streak unconstrained,
+/// an edge the photo shows directly constrained by the pixels it crosses.
+pub(super) fn fitted_lights(
+    problem: &Problem,
+    st: &State,
+    start: &[FittedLight],
+) -> Vec<FittedLight> {
+    let facing = facing_edges(problem, st);
+    (0..st.rects.len())
+        .map(|k| {
+            let origin = &start[problem.set_origin[st.set_of[k]]];
+            let (r, rad) = (st.rects[k], st.radiance[k]);
+            let direct = problem.direct_edge_pixels(st.set_of[k], &r);
+            let mut edges = origin.edges.clone();
+            for side in EdgeSide::ALL {
+                if facing[k][side] {
+                    edges[side] = EdgeStatus::Unconstrained {
+                        reason: FACING_REASON.into(),
+                        pixels: 0,
+                        unseen: false,
+                    };
+                }
+                // An edge the photo shows directly is constrained by the pixels it crosses,
+                // whatever the reflections say of it.
+                if direct[side] > 0 {
+                    let reflected = match edges[side] {
+                        EdgeStatus::Constrained { pixels } => pixels,
+                        EdgeStatus::Unconstrained { .. } => 0,
+                    };
+                    edges[side] = EdgeStatus::Constrained {
+                        pixels: reflected + direct[side],
+                    };
+                }
+            }
+            FittedLight {
+                streak_ids: origin.streak_ids.clone(),
+                plane: origin.plane.clone(),
+                u_min: r.u_min,
+                u_max: r.u_max,
+                v_min: r.v_min,
+                v_max: r.v_max,
+                radiance: rad.map(|c| c as f32),
+                edges,
+            }
+        })
+        .collect()
 }
