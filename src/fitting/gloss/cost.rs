@@ -23,6 +23,9 @@ pub(super) struct SearchFit<'a> {
     pub(super) progress: Reporter<'a>,
     /// Whether the candidates' fits read the direct view, as the final fit does.
     pub(super) direct_view: bool,
+    /// Whether a light on its lamp's whole image searches close around the image, as the
+    /// final fit does ([`JointOptions::close_regions`]).
+    pub(super) close_regions: bool,
 }
 
 /// The gloss whose lobe picks the fitted pixels for every candidate: a quarter of the start
@@ -98,7 +101,7 @@ impl Curve for &mut Cost<'_> {
                 // would fit the lobe's error, not a second light.
                 split: false,
                 region_gloss: Some(region_gloss(self.options, self.fit.model.gloss)),
-                close_regions: false,
+                close_regions: self.fit.close_regions,
                 direct_view: self.fit.direct_view,
                 reweight: Some(Reweight {
                     cache: &self.proposal,

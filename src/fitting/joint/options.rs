@@ -72,12 +72,11 @@ pub struct JointOptions<'a> {
     /// is not glitter).
     pub glitter_weights: bool,
     /// Hold the region of interest of a light whose lamp the photo shows whole close around
-    /// the lamp's image (`region::region_of_interest`). On by default. Off where the lobe is
-    /// wide or may be wrong: there a sample landing outside the close region, never traced,
-    /// still reaches into the light through its kernel (under the statistical model, Table
-    /// 1's radiance came out 8.6 % low instead of 7.5 %), and a fit at a gloss far from the
-    /// photo's needs its light free to grow (Table 3's gloss searched from e = 100 came out
-    /// at 263, not 500).
+    /// the lamp's image (`region::region_of_interest`). On by default, and in a gloss
+    /// search's fits, which follow the final fit. Off under the statistical model, whose
+    /// lobes are wide: there a sample landing outside the close region, never traced, still
+    /// reaches into the light through its kernel (Table 1's radiance came out 8.6 % low
+    /// instead of 7.5 %).
     pub close_regions: bool,
     /// Per fitted pixel, the scale of its row as a fit before over the same pixels measured
     /// it ([`super::JointOutcome::row_scales`]): the fit is weighted by it from the start,
