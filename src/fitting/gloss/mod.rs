@@ -101,8 +101,8 @@
 //! the cost by the residual variance per degree of freedom `s2`, so `sigma(ln e) = sqrt(s2 / k)`.
 //! That is the photo's statistical limit (pixel noise independent): it leaves out the model's
 //! own errors and the Monte Carlo noise of the fits, and is a lower bound. On the samples it
-//! is about 0.06 %, while the estimates (`tests/gloss.rs`) are 201.5 for e = 200, 503.0 for
-//! 500 and 989.3 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
+//! is about 0.06 %, while the estimates (`tests/gloss.rs`) are 201.4 for e = 200, 503.3 for
+//! 500 and 989.4 for 1000, and the seed of the fits moved them by about 1 % (seeds 1-3,
 //! measured when the search was written). Read the estimate as good to a few percent.
 //!
 //! # Limits
