@@ -87,9 +87,10 @@
 //! when the vertex is within the tolerance of the lowest point in a narrow bracket; the
 //! estimate is that vertex. On the samples that takes 3 evaluations from the right gloss, 7
 //! from a start 2 times off (`gloss1000.png` from 500) and 8 from one 2.5 times off
-//! (`gloss200.png` from 500, with 2 more made again on a second trace). On 2 cores a fit
-//! from the kept trace takes about 0.9 s, most of it the descent (a held one far less), and
-//! a trace about 1.3 s; then the final joint fit at the estimate. Where the fits on the last
+//! (`gloss200.png` from 500, with 2 more made again on a second trace). On 2 cores (the AMD
+//! EPYC machine of BENCHMARKS.md) a fit from the kept trace takes about 0.5 s, most of it
+//! the descent (a held one 0.15 s), and a trace about 0.7 s; then the final joint fit at the
+//! estimate. Where the fits on the last
 //! trace held every light and that trace serves the estimate, the final fit weighs it too,
 //! over the search's pixels and region, each light resumed where it was held (its edges
 //! searched a fraction of a footprint around it: [`JointOptions::resume`]); otherwise it is
