@@ -5,10 +5,11 @@
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use common::fit_case::render_like_samples;
-use common::pipeline::{sample_photo_path, sample_scenes, sample_scenes_in};
+use common::pipeline::{sample_photo_path, sample_scenes};
 use common::truth::{assert_light_within, assert_within_sigmas, nearest, RadianceBar::OfChannel};
 use serde_json::{json, Value};
 use streaklight::convert::{convert, ConvertOptions};
@@ -47,32 +48,49 @@ fn street(dir: &Path, file: &str, wall_z: f64, light: Option<&SampleLight>) -> V
     doc
 }
 
-/// Renders `light` on a wall at `wall_z` as the samples are rendered (256 spp, exposure 0.1,
-/// seed 1) and fits the photo at the defaults, with or without the direct view.
-fn render_and_fit(name: &str, wall_z: f64, light: &SampleLight, direct_view: bool) -> Report {
-    let dir = sample_scenes_in(name);
-    let truth = dir.join("street-truth.gltf");
-    let doc = street(&dir, "table1-truth.gltf", wall_z, Some(light));
-    std::fs::write(&truth, doc.to_string()).expect("write the truth scene");
-    let doc = street(&dir, "scene.gltf", wall_z, None);
-    std::fs::write(dir.join("street.gltf"), doc.to_string()).expect("write the scene");
-    let photo = dir.join("street.png");
-    render_like_samples(&truth, &photo, WIDTH, HEIGHT);
+/// The photo of far light `k` of [`far_lights`] on its wall, rendered as the samples are
+/// (256 spp, exposure 0.1, seed 1) once per test binary into the shared sample scenes'
+/// folder, and the scene to fit it against: (scene, photo). The light in the photo and the
+/// one from the reflections alone read the same render.
+fn street_photo(k: usize) -> &'static (PathBuf, PathBuf) {
+    static PHOTOS: [OnceLock<(PathBuf, PathBuf)>; 2] = [OnceLock::new(), OnceLock::new()];
+    PHOTOS[k].get_or_init(|| {
+        let (wall_z, light) = &far_lights()[k];
+        let dir = sample_scenes();
+        let truth = dir.join(format!("street-{k}-truth.gltf"));
+        let doc = street(dir, "table1-truth.gltf", *wall_z, Some(light));
+        std::fs::write(&truth, doc.to_string()).expect("write the truth scene");
+        let scene = dir.join(format!("street-{k}.gltf"));
+        let doc = street(dir, "scene.gltf", *wall_z, None);
+        std::fs::write(&scene, doc.to_string()).expect("write the scene");
+        let photo = dir.join(format!("street-{k}.png"));
+        render_like_samples(&truth, &photo, WIDTH, HEIGHT);
+        (scene, photo)
+    })
+}
+
+/// Far light `k`'s photo ([`street_photo`]) fitted at the defaults, with or without the
+/// direct view.
+fn render_and_fit(k: usize, direct_view: bool) -> Report {
+    let (scene, photo) = street_photo(k);
     let fit = match FitSettings::default().method {
         Method::Joint(j) => Method::Joint(JointSettings { direct_view, ..j }),
         paper => paper,
     };
+    let seen = if direct_view { "direct" } else { "reflections" };
     let options = ConvertOptions {
         exposure: samples::PHOTO_EXPOSURE,
         fit: FitSettings {
             method: fit,
             ..FitSettings::default()
         },
-        ..ConvertOptions::new(dir.join("street.gltf"), photo, dir.join("out.gltf"))
+        ..ConvertOptions::new(
+            scene.clone(),
+            photo.clone(),
+            sample_scenes().join(format!("street-{k}-{seen}-fit.gltf")),
+        )
     };
-    let report = convert(&options).expect("fit").report;
-    let _ = std::fs::remove_dir_all(&dir);
-    report
+    convert(&options).expect("fit").report
 }
 
 /// The two far lights: 1.5 x 1.2 m on a wall 16 m from the camera (z = -6), and 1.2 x 1.5 m
@@ -101,8 +119,8 @@ fn far_lights() -> [(f64, SampleLight); 2] {
 /// radiance.
 #[test]
 fn far_small_lights_in_the_photo_within_one_percent() {
-    for (k, (wall_z, light)) in far_lights().iter().enumerate() {
-        let report = render_and_fit(&format!("far-{k}"), *wall_z, light, true);
+    for (k, (_, light)) in far_lights().iter().enumerate() {
+        let report = render_and_fit(k, true);
         assert_eq!(
             report.lights.len(),
             1,
@@ -120,8 +138,8 @@ fn far_small_lights_in_the_photo_within_one_percent() {
 /// at 0.4 sigma, radiance -5.2 % at 0.4 sigma, sigmas 8.6 % and 13.8 %).
 #[test]
 fn far_small_lights_from_the_reflections_alone_within_their_sigmas() {
-    let (wall_z, light) = &far_lights()[0];
-    let report = render_and_fit("far-reflections", *wall_z, light, false);
+    let (_, light) = &far_lights()[0];
+    let report = render_and_fit(0, false);
     assert_eq!(report.lights.len(), 1, "{:?}", report.warnings);
     let l = &report.lights[0];
     let u = l.uncertainty.as_ref().expect("uncertainties");
