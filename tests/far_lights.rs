@@ -71,7 +71,7 @@ fn street_photo(k: usize) -> &'static (PathBuf, PathBuf) {
 
 /// Far light `k`'s photo ([`street_photo`]) fitted at the defaults, with or without the
 /// direct view.
-fn render_and_fit(k: usize, direct_view: bool) -> Report {
+fn fit_far_light(k: usize, direct_view: bool) -> Report {
     let (scene, photo) = street_photo(k);
     let fit = match FitSettings::default().method {
         Method::Joint(j) => Method::Joint(JointSettings { direct_view, ..j }),
@@ -120,7 +120,7 @@ fn far_lights() -> [(f64, SampleLight); 2] {
 #[test]
 fn far_small_lights_in_the_photo_within_one_percent() {
     for (k, (_, light)) in far_lights().iter().enumerate() {
-        let report = render_and_fit(k, true);
+        let report = fit_far_light(k, true);
         assert_eq!(
             report.lights.len(),
             1,
@@ -139,7 +139,7 @@ fn far_small_lights_in_the_photo_within_one_percent() {
 #[test]
 fn far_small_lights_from_the_reflections_alone_within_their_sigmas() {
     let (_, light) = &far_lights()[0];
-    let report = render_and_fit(0, false);
+    let report = fit_far_light(0, false);
     assert_eq!(report.lights.len(), 1, "{:?}", report.warnings);
     let l = &report.lights[0];
     let u = l.uncertainty.as_ref().expect("uncertainties");
