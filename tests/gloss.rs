@@ -28,12 +28,27 @@ fn estimate_seeded(
     search: &GlossSearch,
     seed: u64,
 ) -> streaklight::Result<GlossEstimate> {
+    estimate_with(scene, photo, water, streaks, search, seed, true)
+}
+
+/// [`estimate_seeded`], the final fit's (and so the search's) regions close around whole
+/// lamps' images or not (`JointOptions::close_regions`).
+fn estimate_with(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    search: &GlossSearch,
+    seed: u64,
+    close_regions: bool,
+) -> streaklight::Result<GlossEstimate> {
     let paper = FitOptions {
         seed,
         ..FitOptions::for_scene(scene)
     };
     let final_fit = JointOptions {
         samples: SEARCH_SAMPLES,
+        close_regions,
         ..JointOptions::new(paper.model, seed)
     };
     estimate_gloss(scene, photo, water, streaks, &paper, &final_fit, search)
@@ -422,23 +437,9 @@ fn a_whole_lamp_holds_the_search_close_to_its_image() {
     let photo = sample_photo("table1.png");
     let water = water(&scene, &photo);
     let streaks = observations(&photo, &water);
-    let run = |close_regions: bool| {
-        let paper = FitOptions {
-            seed: 1,
-            ..FitOptions::for_scene(&scene)
-        };
-        let final_fit = JointOptions {
-            samples: SEARCH_SAMPLES,
-            close_regions,
-            ..JointOptions::new(paper.model, 1)
-        };
-        let search = GlossSearch::default();
-        estimate_gloss(
-            &scene, &photo, &water, &streaks, &paper, &final_fit, &search,
-        )
-        .unwrap()
-    };
-    let (close, wide) = (run(true), run(false));
+    let search = GlossSearch::default();
+    let run = |close: bool| estimate_with(&scene, &photo, &water, &streaks, &search, 1, close);
+    let (close, wide) = (run(true).unwrap(), run(false).unwrap());
     let direct = |e: &GlossEstimate| e.pixels - e.modelled.len();
     eprintln!(
         "close: e {:.1}, {} water and {} direct pixels; wide: e {:.1}, {} and {}",
