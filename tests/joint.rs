@@ -277,8 +277,8 @@ fn joint_fits_table3() {
 /// Repeated joint fits of the stacked lights from the reflections alone (`--repeats 2`,
 /// without the direct view): their mean, with the spread of
 /// the 2 fits from independent samples added to the uncertainties. The lower light's error
-/// through the overlap is a bias common to the fits (it grows into the overlap: top +11 %,
-/// radiance -10 % for seed 1), which no spread of them shows; it is the curvature of the
+/// through the overlap is a bias common to the fits (it grows into the overlap: top +10 %,
+/// radiance 7 % off for seed 1), which no spread of them shows; it is the curvature of the
 /// noise-corrected cost that reports it (the spread bench, BENCHMARKS.md). Held
 /// here: every parameter of both lights that has a sigma within 6 of it for the default seed
 /// (the facing edges the split made are unconstrained, with none); measured: 1.1 at most.

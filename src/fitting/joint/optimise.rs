@@ -146,7 +146,7 @@ pub(super) fn optimise(
                 st.rects.len()
             ));
             replay = st.clone();
-            problem.descend(&mut st, extents, sweeps);
+            problem.descend_with_pattern_moves(&mut st, extents, sweeps);
         }
     }
     (st, replay, splits)
@@ -229,7 +229,11 @@ impl Problem {
             from.rects.clone(),
             from.radiance.clone(),
         );
-        self.descend(&mut st, extents, sweeps);
+        if extra_origins.is_empty() {
+            self.descend(&mut st, extents, sweeps);
+        } else {
+            self.descend_with_pattern_moves(&mut st, extents, sweeps);
+        }
         st
     }
 }
