@@ -61,9 +61,8 @@ impl Problem {
     }
 
     /// [`Self::descend`], with a pattern move after each sweep from the second on
-    /// ([`Self::pattern_move`]): the descents of a split (its trial, the boundary candidates'
-    /// and the one after them), whose lights creep along valleys that single-edge steps cross
-    /// only in a zig-zag.
+    /// ([`Self::pattern_move`]): the descent after a split, whose lights creep along a valley
+    /// that single-edge steps cross only in a zig-zag.
     pub(super) fn descend_with_pattern_moves(
         &self,
         st: &mut State,
@@ -202,10 +201,7 @@ impl Problem {
     /// its sweep limit short of the minimum: on the orange and blue lamps out of frame the
     /// blue light's height still shrank by half a millimetre and its radiance rose by 0.3 %
     /// in the 14th sweep (docs/decisions.md). A sweep's displacement points along the
-    /// valley, and a move along it costs a few cost evaluations, not a sweep. In a split's
-    /// trial and its boundary candidates' short descents (8 and 4 sweeps) the two halves'
-    /// facing edges and radiances creep the same way, and the boundary search and the final
-    /// descent start from where those end.
+    /// valley, and a move along it costs a few cost evaluations, not a sweep.
     fn pattern_move(
         &self,
         st: &mut State,

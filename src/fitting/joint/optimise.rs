@@ -129,7 +129,7 @@ pub(super) fn optimise(
             let mut best: Option<(State, f64)> = None;
             for (done, mut cand) in starts.into_iter().enumerate() {
                 progress.advance(done as u64, candidates);
-                problem.descend_with_pattern_moves(&mut cand, extents, CANDIDATE_SWEEPS);
+                problem.descend(&mut cand, extents, CANDIDATE_SWEEPS);
                 let c = problem.cost(&cand);
                 if best.as_ref().is_none_or(|(_, b)| c < *b) {
                     best = Some((cand, c));

@@ -104,7 +104,7 @@ pub(super) fn try_split(
             })
             .collect();
         let mut trial = problem.state(set_of, held, rects, radiance);
-        problem.descend_with_pattern_moves(&mut trial, extents, SPLIT_TRIAL_SWEEPS);
+        problem.descend(&mut trial, extents, SPLIT_TRIAL_SWEEPS);
         trial.pinned = pinned;
         let c = problem.row_cost(&trial);
         let both_lit = [k, trial.rects.len() - 1]
