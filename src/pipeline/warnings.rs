@@ -99,9 +99,9 @@ pub(super) fn shares_a_streak(lights: &[FittedLight], seen: &[bool]) -> bool {
 /// joint fit; a light merged from two streaks and then split makes one warning naming both
 /// streaks) and that the reflections alone must tell apart ([`lights_by_shared_streak`]):
 /// the photo tells such lights apart only weakly, so their facing edges and
-/// radiances can be off by several percent (on the bundled stacked sample, even with the
-/// refit over every pixel, the facing edges are about 5 % rms off over 8 seeds and the upper
-/// light's radiance up to 14 %: BENCHMARKS.md, the spread bench). Their reported
+/// radiances can be off by several percent (on the bundled stacked sample from the
+/// reflections alone, even with the refit over every pixel, 7-8 % rms over 10 seeds and up
+/// to 23 % on one: BENCHMARKS.md, "From the reflections alone"). Their reported
 /// uncertainties are as wide; the warning says why. Unless the fit already read every pixel
 /// with at least [`THOROUGH`]'s samples (`thorough`), it also says how to fit such lights
 /// more closely. Lights are named by [`light_name`] of their index.
@@ -130,8 +130,8 @@ pub(super) fn shared_streak_warnings(
             format!(
                 "{noun} {} {verb} {} lights ({}), whose reflections overlap: the photo tells them \
                  apart only weakly where they meet, so their facing edges and radiances may be off \
-                 by several percent (up to about 15 % on the bundled stacked sample); their reported \
-                 uncertainties are correspondingly wide{}",
+                 by several percent (on the bundled stacked sample 8 % rms, up to about 25 %); \
+                 their reported uncertainties are correspondingly wide{}",
                 ids.join(", "),
                 names.len(),
                 names.join(", "),
