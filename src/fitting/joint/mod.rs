@@ -235,10 +235,11 @@ pub fn fit_joint_with(
     // (`region_of_interest`, `JointOptions::close_regions`); where every light is on one, a
     // fit that may thin its pixels does (`JointOptions::share_for`).
     let may_thin = options.share_for(true) != options.pixels;
+    // A glitter-weighted fit reads them too (`weights_at_start` below).
     let images: Vec<Option<(Rect, f32)>> = start
         .iter()
         .map(|light| {
-            (options.direct_view && (options.close_regions || may_thin))
+            (options.direct_view && (options.close_regions || may_thin || options.glitter_weights))
                 .then(|| enclosing_image(scene, photo, water, light))
                 .flatten()
         })
@@ -325,6 +326,16 @@ pub fn fit_joint_with(
     let given_scales = options
         .row_scales
         .filter(|s| s.len() == pixels.len() && options.repeats == 1);
+    // Glitter weights measured at the start rather than after an unweighted descent, where
+    // the start is already within a fraction of a footprint of the optimum: every light
+    // resumed where a search fit put it, or on its lamp's whole direct image (`glitter`).
+    let resumed = options.resume.len() == start.len() && options.resume.iter().all(Option::is_some);
+    let weights_at_start = options.glitter_weights
+        && given_scales.is_none()
+        && options.repeats == 1
+        && (resumed || images.iter().all(Option::is_some));
+    // The rows' scales in force, which a sample set traced later takes too.
+    let scales_in_force: std::cell::OnceCell<Vec<f32>> = std::cell::OnceCell::new();
     // Seconds spent tracing the split lights' own sample sets (footprints, not optimisation).
     let fresh_seconds = std::cell::Cell::new(0.0);
     // The `draw`-th extra sample set of repeat `repeat`, on start light `origin`'s plane,
@@ -335,7 +346,7 @@ pub fn fit_joint_with(
         fresh_seconds.set(fresh_seconds.get() + t.elapsed().as_secs_f64());
         // One plane in, one set out, weighted as the others.
         let mut set = stored.swap_remove(0);
-        if let Some(s) = given_scales {
+        if let Some(s) = scales_in_force.get() {
             glitter::scale_set(&mut set, s);
         }
         set
@@ -354,6 +365,7 @@ pub fn fit_joint_with(
     let mut problem = problem_for(0);
     if let Some(s) = given_scales {
         glitter::scale_rows(&mut problem, s);
+        let _ = scales_in_force.set(s.to_vec());
     }
     let mut footprint_seconds = t0.elapsed().as_secs_f64();
     let mut extents: Vec<Option<Rect>> = problem.planes.iter().map(sample_extent).collect();
@@ -394,6 +406,15 @@ pub fn fit_joint_with(
             options.sweeps
         )
     });
+    if weights_at_start {
+        let mut st = start_state(&problem, start, &extents, options.held, options.resume);
+        problem.solve_radiance(&mut st);
+        let areas = glitter::footprint_areas(water_model, scene, &problem, photo.height);
+        if let Some((_, s)) = glitter::glitter_scales(&problem, &st, &areas) {
+            glitter::scale_rows(&mut problem, &s);
+            let _ = scales_in_force.set(s);
+        }
+    }
     let t1 = Instant::now();
     let (first, replay, splits) = optimise(
         &mut problem,
@@ -466,10 +487,11 @@ pub fn fit_joint_with(
         (State { radiance, ..st }, Some(spread))
     };
     let mut spread = spread;
-    // Weighted by the glitter's noise where asked (`glitter`): the first fit's residual
-    // gives the noise model, and the fit is descended again over the weighted rows.
-    let mut scales: Option<Vec<f32>> = given_scales.map(|s| s.to_vec());
-    if options.glitter_weights && scales.is_none() && repeats.len() == 1 {
+    // Weighted by the glitter's noise where asked (`glitter`) and not weighted from the
+    // start: the first fit's residual gives the noise model, and the fit is descended again
+    // over the weighted rows.
+    let mut scales: Option<Vec<f32>> = scales_in_force.get().cloned();
+    if options.glitter_weights && !weights_at_start && scales.is_none() && repeats.len() == 1 {
         let areas = glitter::footprint_areas(water_model, scene, &problem, photo.height);
         if let Some((_, s)) = glitter::glitter_scales(&problem, &st, &areas) {
             glitter::scale_rows(&mut problem, &s);

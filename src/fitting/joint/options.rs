@@ -68,8 +68,11 @@ pub struct JointOptions<'a> {
     pub stacked_as_one: bool,
     /// Weight the water pixels by the glitter's noise (`glitter`): a first fit's residual
     /// gives each pixel's variance from its expectation and footprint, and the fit is
-    /// descended again by weighted least squares. Off by default (the exact model's residual
-    /// is not glitter).
+    /// descended again by weighted least squares. Where the start is already within a
+    /// fraction of a footprint of the optimum (every light on its lamp's whole direct image,
+    /// or [`resume`](Self::resume)d where a search fit put it), the residual at the start
+    /// gives the weights and the fit descends once, weighted. Off by default (the exact
+    /// model's residual is not glitter).
     pub glitter_weights: bool,
     /// Hold the region of interest of a light whose lamp the photo shows whole close around
     /// the lamp's image (`region::region_of_interest`). On by default, and in a gloss
