@@ -80,13 +80,50 @@ impl GaussianSlopes {
         wo: Vec3,
         draw: &SlopeDraw,
     ) -> Option<LobeSample> {
-        let m = self.mirror(n, t, wo, draw)?;
+        self.sample_in(model, &self.view(model, n, t, wo)?, draw)
+    }
+
+    /// What every sample and value of this lobe seen from `wo` at a mean surface of unit
+    /// normal `n` and unit tangent `t` shares (the frame, the view's cosine and its masking
+    /// under `model`'s shadowing); `None` when `wo` lies below the surface (no sample, and
+    /// every value 0).
+    #[inline]
+    pub fn view(&self, model: &ReflectionModel, n: Vec3, t: Vec3, wo: Vec3) -> Option<SlopeView> {
+        let cos_o = n.dot(wo);
+        if cos_o <= 0.0 {
+            return None;
+        }
+        let b = n.cross(t);
+        let g1_o = match model.shadowing {
+            Shadowing::None => 1.0,
+            Shadowing::Smith => self.g1(b, t, wo, cos_o),
+        };
+        Some(SlopeView {
+            n,
+            t,
+            b,
+            wo,
+            cos_o,
+            g1_o,
+        })
+    }
+
+    /// [`sample_drawn`](Self::sample_drawn) from its [`view`](Self::view) (made with the
+    /// same `model`): the same sample to the last bit, for many draws at one view.
+    #[inline]
+    pub fn sample_in(
+        &self,
+        model: &ReflectionModel,
+        view: &SlopeView,
+        draw: &SlopeDraw,
+    ) -> Option<LobeSample> {
+        let m = Self::mirror(view, draw)?;
         let fresnel = fresnel_dielectric(m.cos_oh, model.ior);
         let g = match model.shadowing {
-            Shadowing::None => energy_cap(m.cos_o, m.cos_h, m.cos_oh, fresnel),
-            Shadowing::Smith => self.g1(n, t, wo, m.cos_o) * self.g1(n, t, m.wi, m.cos_i),
+            Shadowing::None => energy_cap(view.cos_o, m.cos_h, m.cos_oh, fresnel),
+            Shadowing::Smith => view.g1_o * self.g1(view.b, view.t, m.wi, m.cos_i),
         };
-        let weight = KEEP * fresnel * g * m.cos_oh / (m.cos_o * m.cos_h);
+        let weight = KEEP * fresnel * g * m.cos_oh / (view.cos_o * m.cos_h);
         // pdf_h = xi / (2 pi sigma_t sigma_b KEEP cos^3 theta_h); pdf(wi) = pdf_h / (4 wo.h).
         let sigma_tb = (self.variance[0] * self.variance[1]).sqrt();
         let cos3 = m.cos_h * m.cos_h * m.cos_h;
@@ -102,7 +139,8 @@ impl GaussianSlopes {
     /// weight.
     #[inline]
     pub fn direction(&self, n: Vec3, t: Vec3, wo: Vec3, u: Vec2) -> Option<Vec3> {
-        self.mirror(n, t, wo, &self.draw(u)).map(|m| m.wi)
+        let view = self.view(&Self::UNMASKED, n, t, wo)?;
+        Self::mirror(&view, &self.draw(u)).map(|m| m.wi)
     }
 
     /// The slope drawn from `u` (module doc): what depends on `u` and the variances alone.
@@ -125,8 +163,19 @@ impl GaussianSlopes {
     /// BRDF times the cosine at the light, 0 outside the truncation ellipse or below the
     /// surface. For tests and brute-force integrals.
     pub fn eval_cos(&self, model: &ReflectionModel, n: Vec3, t: Vec3, wo: Vec3, wi: Vec3) -> f32 {
-        let (cos_o, cos_i) = (n.dot(wo), n.dot(wi));
-        if cos_o <= 0.0 || cos_i <= 0.0 {
+        self.view(model, n, t, wo)
+            .map_or(0.0, |view| self.eval_cos_in(model, &view, wi))
+    }
+
+    /// [`eval_cos`](Self::eval_cos) from its [`view`](Self::view) (made with the same
+    /// `model`): the same value to the last bit, for many directions at one view.
+    #[inline]
+    pub fn eval_cos_in(&self, model: &ReflectionModel, view: &SlopeView, wi: Vec3) -> f32 {
+        let SlopeView {
+            n, t, b, wo, cos_o, ..
+        } = *view;
+        let cos_i = n.dot(wi);
+        if cos_i <= 0.0 {
             return 0.0;
         }
         let h = (wo + wi).normalize();
@@ -134,7 +183,6 @@ impl GaussianSlopes {
         if cos_h <= 0.0 {
             return 0.0;
         }
-        let b = n.cross(t);
         let p = Vec2::new(-t.dot(h), -b.dot(h)) / cos_h;
         let q = p.x * p.x / self.variance[0] + p.y * p.y / self.variance[1];
         if q > -2.0 * (CONE_LOST_MASS as f32).ln() {
@@ -146,7 +194,7 @@ impl GaussianSlopes {
         let fresnel = fresnel_dielectric(cos_oh, model.ior);
         let g = match model.shadowing {
             Shadowing::None => energy_cap(cos_o, cos_h, cos_oh, fresnel),
-            Shadowing::Smith => self.g1(n, t, wo, cos_o) * self.g1(n, t, wi, cos_i),
+            Shadowing::Smith => view.g1_o * self.g1(b, t, wi, cos_i),
         };
         d * fresnel * g / (4.0 * cos_o)
     }
@@ -156,8 +204,7 @@ impl GaussianSlopes {
     /// "Understanding the Masking-Shadowing Function", §5.3: `alpha_w^2 = cos^2 phi alpha_t^2
     /// + sin^2 phi alpha_b^2`, `alpha^2 = 2 variance`).
     #[inline]
-    fn g1(&self, n: Vec3, t: Vec3, w: Vec3, cos_w: f32) -> f32 {
-        let b = n.cross(t);
+    fn g1(&self, b: Vec3, t: Vec3, w: Vec3, cos_w: f32) -> f32 {
         let (wt, wb) = (w.dot(t), w.dot(b));
         let r2 = wt * wt + wb * wb;
         if r2 <= 0.0 {
@@ -168,18 +215,14 @@ impl GaussianSlopes {
     }
 
     #[inline]
-    fn mirror(&self, n: Vec3, t: Vec3, wo: Vec3, draw: &SlopeDraw) -> Option<Mirrored> {
-        let cos_o = n.dot(wo);
-        if cos_o <= 0.0 {
-            return None;
-        }
+    fn mirror(view: &SlopeView, draw: &SlopeDraw) -> Option<Mirrored> {
+        let SlopeView { n, t, b, wo, .. } = *view;
         let SlopeDraw {
             xi,
             p_t,
             p_b,
             inv_len,
         } = *draw;
-        let b = n.cross(t);
         let h = (n - t * p_t - b * p_b) * inv_len;
         let cos_h = inv_len;
         let cos_oh = wo.dot(h);
@@ -194,12 +237,33 @@ impl GaussianSlopes {
         Some(Mirrored {
             wi,
             xi,
-            cos_o,
             cos_h,
             cos_oh,
             cos_i,
         })
     }
+
+    /// A model whose view computes no masking, for directions alone.
+    const UNMASKED: ReflectionModel = ReflectionModel {
+        gloss: 1.0,
+        ior: 1.0,
+        shadowing: Shadowing::None,
+    };
+}
+
+/// What every sample and value of one lobe seen from one direction shares
+/// ([`GaussianSlopes::view`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlopeView {
+    n: Vec3,
+    t: Vec3,
+    /// `n x t`.
+    b: Vec3,
+    wo: Vec3,
+    /// `n.wo`, > 0.
+    cos_o: f32,
+    /// Smith's masking of `wo` under the view's model (1 without masking).
+    g1_o: f32,
 }
 
 /// A slope drawn for [`GaussianSlopes::sample`].
@@ -218,7 +282,6 @@ pub struct SlopeDraw {
 struct Mirrored {
     wi: Vec3,
     xi: f32,
-    cos_o: f32,
     cos_h: f32,
     cos_oh: f32,
     cos_i: f32,

@@ -54,7 +54,7 @@ mod shadowing;
 pub use coefficient::reflection_coefficient;
 pub use frame::orthonormal_basis;
 pub use fresnel::{fresnel_dielectric, fresnel_dielectric_sp};
-pub use gaussian_slopes::{GaussianSlopes, SlopeDraw};
+pub use gaussian_slopes::{GaussianSlopes, SlopeDraw, SlopeView};
 pub use lobe::{compact_strata, HalfDraw, LobeSample, ReflectionModel};
 pub use microfacet::{blinn_phong_d, cone_cos_theta, CONE_LOST_MASS};
 pub use shadowing::{beckmann_alpha, energy_cap, smith_g1, smith_g1_alpha, Shadowing};

@@ -84,12 +84,17 @@ impl LobeDraws {
         }
     }
 
-    /// The `i`-th slope, when these are `slopes`'.
-    pub fn slope(&self, i: usize, slopes: &GaussianSlopes) -> Option<&SlopeDraw> {
+    /// Every slope, when these are `slopes`'.
+    pub fn slopes_of(&self, slopes: &GaussianSlopes) -> Option<&[SlopeDraw]> {
         match &self.made {
-            Made::Slopes { slopes: s, draws } if s == slopes => draws.get(i),
+            Made::Slopes { slopes: s, draws } if s == slopes => Some(draws),
             _ => None,
         }
+    }
+
+    /// The `i`-th slope, when these are `slopes`'.
+    pub fn slope(&self, i: usize, slopes: &GaussianSlopes) -> Option<&SlopeDraw> {
+        self.slopes_of(slopes)?.get(i)
     }
 }
 
@@ -114,10 +119,20 @@ mod tests {
         })
     }
 
+    /// Bits of a direction and its weight.
+    fn pair_bits((wi, weight): (Vec3, f32)) -> [u32; 4] {
+        [
+            wi.x.to_bits(),
+            wi.y.to_bits(),
+            wi.z.to_bits(),
+            weight.to_bits(),
+        ]
+    }
+
     /// Both models, at water points seen from 2 to 60 degrees above the water under tilted
     /// shading normals: a sample from draws made once is the sample drawn from its pair, to
-    /// the last bit; draws made for another lobe (another gloss, other variances) are drawn
-    /// again from the pairs, to the same samples.
+    /// the last bit, one at a time or all of a point's at once; draws made for another lobe
+    /// (another gloss, other variances) are drawn again from the pairs, to the same samples.
     #[test]
     fn a_sample_from_draws_made_once_is_the_sample_drawn_from_its_pair() {
         let pairs: Vec<Vec2> = (0..400)
@@ -172,7 +187,34 @@ mod tests {
                     );
                     compared += want.is_some() as usize;
                 }
+                // All of a point's samples at once: the same, in order, the rejected left out.
+                let want: Vec<[u32; 4]> = pairs
+                    .iter()
+                    .filter_map(|&u| water_model.reflect(&point, &model, u))
+                    .map(|s| pair_bits((s.wi, s.weight)))
+                    .collect();
+                let mut all = vec![(Vec3::ZERO, 0.0); 3];
+                for draws in [&own, &foreign_gloss, &foreign_model] {
+                    water_model.reflect_all_drawn(&point, &model, draws, &mut all);
+                    assert_eq!(all.iter().copied().map(pair_bits).collect::<Vec<_>>(), want);
+                }
             }
+            // Seen from below the surface: nothing.
+            let below = WaterPoint {
+                start: Vec3::new(0.0, -2.0, -5.0),
+                wo: Vec3::new(0.1, -0.2, 1.0).normalize(),
+                normal: Vec3::Y,
+                face: Vec3::Y,
+                clear: 0.0,
+            };
+            let mut all = vec![(Vec3::ZERO, 0.0); 3];
+            water_model.reflect_all_drawn(
+                &below,
+                &model,
+                &water_model.lobe_draws(&model, &pairs),
+                &mut all,
+            );
+            assert!(all.is_empty(), "{all:?}");
         }
         // Most pairs reflect something (the rest leave below the surface at grazing views).
         assert!(compared > 2000, "{compared} samples compared");

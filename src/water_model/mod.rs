@@ -42,7 +42,7 @@ use glam::{Vec2, Vec3};
 pub use draws::LobeDraws;
 pub use exact::ExactSurface;
 pub use mean_surface::{water_statistics, MeanSurface, WaterStatistics};
-pub use statistical::StatisticalSurface;
+pub use statistical::{StatisticalSurface, ViewedLobe};
 
 use crate::optics::{LobeSample, ReflectionModel};
 use crate::render::WaterPoint;
@@ -150,6 +150,37 @@ pub trait WaterModel: Sync + std::fmt::Debug {
     ) -> Option<LobeSample> {
         self.reflect(point, model, draws.pair(i))
     }
+
+    /// [`reflect_drawn`](Self::reflect_drawn) of `point` for every pair of `draws` in
+    /// order, into `out` (cleared first) as each sample's `wi` and weight, the pairs it
+    /// rejects left out: the same samples to the last bit. A model may share what the
+    /// point's samples have in common.
+    fn reflect_all_drawn(
+        &self,
+        point: &WaterPoint,
+        model: &ReflectionModel,
+        draws: &LobeDraws,
+        out: &mut Vec<(Vec3, f32)>,
+    ) {
+        reflect_each_drawn(self, point, model, draws, out);
+    }
+}
+
+/// [`WaterModel::reflect_all_drawn`] one pair at a time, by
+/// [`WaterModel::reflect_drawn`].
+fn reflect_each_drawn<M: WaterModel + ?Sized>(
+    water: &M,
+    point: &WaterPoint,
+    model: &ReflectionModel,
+    draws: &LobeDraws,
+    out: &mut Vec<(Vec3, f32)>,
+) {
+    out.clear();
+    out.extend(
+        (0..draws.len())
+            .filter_map(|i| water.reflect_drawn(point, model, draws, i))
+            .map(|s| (s.wi, s.weight)),
+    );
 }
 
 #[cfg(test)]

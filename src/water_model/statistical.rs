@@ -29,7 +29,7 @@ use glam::{Vec2, Vec3};
 
 use super::mean_surface::MeanSurface;
 use super::{LobeDraws, WaterModel};
-use crate::optics::{GaussianSlopes, LobeSample, ReflectionModel, Shadowing};
+use crate::optics::{GaussianSlopes, LobeSample, ReflectionModel, Shadowing, SlopeView};
 use crate::render::{camera_hit, camera_water_points, surface_offset, CameraHit, WaterPoint};
 use crate::scene_in::Scene;
 
@@ -76,13 +76,38 @@ impl StatisticalSurface {
     /// always, as [`WaterModel::reflect`] draws it) at the mean surface: what a sample drawn
     /// towards `wi` from another lobe weighs for this one, over the density it was drawn with.
     pub fn eval_cos(&self, model: &ReflectionModel, wo: Vec3, wi: Vec3) -> f32 {
-        self.slopes(model.gloss).eval_cos(
-            &masked(model),
-            self.surface.normal,
-            self.surface.along,
-            wo,
-            wi,
-        )
+        self.viewed(model, wo).eval_cos(wi)
+    }
+
+    /// The lobe under `model` seen from `wo`, for [`eval_cos`](Self::eval_cos) of many
+    /// directions: the same values to the last bit.
+    pub fn viewed(&self, model: &ReflectionModel, wo: Vec3) -> ViewedLobe {
+        let slopes = self.slopes(model.gloss);
+        let model = masked(model);
+        ViewedLobe {
+            view: slopes.view(&model, self.surface.normal, self.surface.along, wo),
+            slopes,
+            model,
+        }
+    }
+}
+
+/// A statistical lobe seen from one direction ([`StatisticalSurface::viewed`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ViewedLobe {
+    slopes: GaussianSlopes,
+    model: ReflectionModel,
+    /// `None` when the direction lies below the mean surface.
+    view: Option<SlopeView>,
+}
+
+impl ViewedLobe {
+    /// [`StatisticalSurface::eval_cos`] towards `wi`.
+    #[inline]
+    pub fn eval_cos(&self, wi: Vec3) -> f32 {
+        self.view
+            .as_ref()
+            .map_or(0.0, |view| self.slopes.eval_cos_in(&self.model, view, wi))
     }
 }
 
@@ -167,6 +192,31 @@ impl WaterModel for StatisticalSurface {
                 draw,
             ),
             None => self.reflect(point, model, draws.pair(i)),
+        }
+    }
+
+    fn reflect_all_drawn(
+        &self,
+        point: &WaterPoint,
+        model: &ReflectionModel,
+        draws: &LobeDraws,
+        out: &mut Vec<(Vec3, f32)>,
+    ) {
+        let slopes = self.slopes(model.gloss);
+        let Some(drawn) = draws.slopes_of(&slopes) else {
+            // Draws made for another lobe: each drawn again from its pair.
+            return super::reflect_each_drawn(self, point, model, draws, out);
+        };
+        out.clear();
+        let model = masked(model);
+        // The view below the surface: no sample.
+        if let Some(view) = slopes.view(&model, point.normal, self.surface.along, point.wo) {
+            out.extend(
+                drawn
+                    .iter()
+                    .filter_map(|draw| slopes.sample_in(&model, &view, draw))
+                    .map(|s| (s.wi, s.weight)),
+            );
         }
     }
 }

@@ -164,13 +164,8 @@ pub(super) fn lobe_directions(
     water: &WaterPoint,
     grid: &LobeDraws,
 ) -> (Vec<(Vec3, f32)>, usize) {
-    let dirs = (0..grid.len())
-        .filter_map(|i| {
-            water_model
-                .reflect_drawn(water, model, grid, i)
-                .map(|s| (s.wi, s.weight))
-        })
-        .collect();
+    let mut dirs = Vec::with_capacity(grid.len());
+    water_model.reflect_all_drawn(water, model, grid, &mut dirs);
     (dirs, grid.len())
 }
 

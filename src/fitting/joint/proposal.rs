@@ -10,7 +10,7 @@ use super::samples::PlaneSamples;
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::optics::{GaussianSlopes, ReflectionModel};
-use crate::water_model::{ExactSurface, StatisticalSurface, WaterModel};
+use crate::water_model::{ExactSurface, StatisticalSurface, ViewedLobe, WaterModel};
 
 /// The target variances, per axis, as multiples of the proposal's, that a recorded trace
 /// serves. Above 1 the target's lobe reaches where the proposal drew nothing (its truncated
@@ -71,18 +71,33 @@ impl Lobe {
         }
     }
 
-    /// `f cos` of the lobe (`model` at its gloss, [`Self::model`]) for light arriving from
-    /// `wi` at a water point of lobe axis `normal`, seen from `wo`.
-    pub(super) fn eval_cos(
-        &self,
-        model: &ReflectionModel,
+    /// The lobe (`model` at its gloss, [`Self::model`]) seen from `wo` at a water point of
+    /// lobe axis `normal`, for its `f cos` towards many directions ([`LobeAt::eval_cos`]).
+    pub(super) fn at<'a>(&self, model: &'a ReflectionModel, normal: Vec3, wo: Vec3) -> LobeAt<'a> {
+        match self {
+            Lobe::Exact { .. } => LobeAt::Exact { model, normal, wo },
+            Lobe::Statistical { water, .. } => LobeAt::Statistical(water.viewed(model, wo)),
+        }
+    }
+}
+
+/// A lobe seen from one direction ([`Lobe::at`]).
+pub(super) enum LobeAt<'a> {
+    Exact {
+        model: &'a ReflectionModel,
         normal: Vec3,
         wo: Vec3,
-        wi: Vec3,
-    ) -> f32 {
+    },
+    Statistical(ViewedLobe),
+}
+
+impl LobeAt<'_> {
+    /// `f cos` of the lobe for light arriving from `wi`.
+    #[inline]
+    pub(super) fn eval_cos(&self, wi: Vec3) -> f32 {
         match self {
-            Lobe::Exact { .. } => model.eval_cos(normal, wo, wi),
-            Lobe::Statistical { water, .. } => water.eval_cos(model, wo, wi),
+            LobeAt::Exact { model, normal, wo } => model.eval_cos(*normal, *wo, wi),
+            LobeAt::Statistical(lobe) => lobe.eval_cos(wi),
         }
     }
 }

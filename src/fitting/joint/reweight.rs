@@ -28,7 +28,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::control_variate::{grid_draws, lobe_directions, LobeGaussian};
-use super::proposal::Lobe;
+use super::proposal::{Lobe, LobeAt};
 use super::samples::PlaneSamples;
 use crate::fitting::light_plane::LightPlane;
 use crate::optics::ReflectionModel;
@@ -158,7 +158,11 @@ fn reweighted_plane(
             let g = gauss[i];
             let old = &base.weights[r.clone()];
             let points = &base.points[r.clone()];
-            let rays = &rays[i];
+            // The target seen from each of the pixel's camera rays, for all their samples.
+            let seen: Vec<LobeAt> = rays[i]
+                .iter()
+                .map(|&(wo, axis)| target.at(target_model, axis, wo))
+                .collect();
             lobes[r]
                 .iter()
                 .zip(points)
@@ -167,10 +171,8 @@ fn reweighted_plane(
                     if l.pdf < 0.0 {
                         return w;
                     }
-                    let lobe = match rays.get(l.ray as usize) {
-                        Some(&(wo, axis)) if l.pdf > 0.0 => {
-                            target.eval_cos(target_model, axis, wo, l.wi) / l.pdf
-                        }
+                    let lobe = match seen.get(l.ray as usize) {
+                        Some(at) if l.pdf > 0.0 => at.eval_cos(l.wi) / l.pdf,
                         _ => 0.0,
                     };
                     if l.area_pdf > 0.0 {
