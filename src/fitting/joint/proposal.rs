@@ -202,6 +202,11 @@ impl FitSamples<'_> {
         let shared = options
             .reweight
             .filter(|_| repeat == 0 && draw == 0 && options.control_variate);
+        // Where every light is held, only the samples whose kernels reach its rectangle
+        // are ever read.
+        let held: Option<Vec<Rect>> = (options.held.len() == planes.len())
+            .then(|| options.held.iter().copied().collect::<Option<Vec<Rect>>>())
+            .flatten();
         if let Some(out) = shared.and_then(|rw| {
             from_proposal(
                 &rw,
@@ -209,6 +214,7 @@ impl FitSamples<'_> {
                 &options.model,
                 planes,
                 roi,
+                held.as_deref(),
                 self.pixels,
                 self.size,
                 (options.samples, options.seed),
@@ -267,7 +273,9 @@ impl Reweight<'_> {
 /// (with `model`, the fit's pixels `pixels` of a `size` image, `samples` per pixel and
 /// `seed`; the pixels from `first_direct` on see the walls directly): `None` when the trace
 /// cannot serve this fit (the target is not covered, or the trace was made for other pixels,
-/// planes or regions), and the fit traces its own.
+/// planes or regions), and the fit traces its own. With `held` (a rectangle per plane, each
+/// light held there), only the samples a held light's coefficients read are weighted
+/// ([`reweighted`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn from_proposal(
     rw: &Reweight<'_>,
@@ -275,6 +283,7 @@ pub(super) fn from_proposal(
     model: &ReflectionModel,
     planes: &[&LightPlane],
     roi: &[Rect],
+    held: Option<&[Rect]>,
     pixels: &[u32],
     size: (u32, u32),
     (samples, seed): (u32, u64),
@@ -326,6 +335,7 @@ pub(super) fn from_proposal(
         planes,
         &rw.target,
         model,
+        held,
     );
     Some((stored, traced.per_pixel_samples))
 }

@@ -24,13 +24,14 @@
 //! 7-18 % off (docs/decisions.md). Which targets a proposal serves, and the trace a search
 //! keeps, are [`super::proposal`]'s.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::control_variate::{grid_draws, lobe_directions, LobeGaussian};
 use super::proposal::{Lobe, LobeAt};
 use super::samples::PlaneSamples;
 use crate::fitting::light_plane::LightPlane;
+use crate::fitting::rect::Rect;
 use crate::optics::ReflectionModel;
 use crate::render::WaterPoint;
 
@@ -92,6 +93,12 @@ pub(super) struct Recorded {
 /// pixel's lobe directions under the target are drawn once for all the planes: they are
 /// the dearest part of the weighting (over the harbour pair's two planes, drawn per plane,
 /// half of a held search fit's time).
+///
+/// With `held` (one rectangle per plane), a sample whose kernel lies wholly outside its
+/// plane's rectangle is given weight 0 without being weighted: a fit that holds every light
+/// reads its coefficients at those rectangles only, where such a sample's kernel covers
+/// nothing ([`kernel_coverage`](super::kernel::kernel_coverage) is exactly 0 there), so its
+/// coefficients are the same to the last bit.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn reweighted(
     base: &[PlaneSamples],
@@ -102,6 +109,7 @@ pub(super) fn reweighted(
     planes: &[&LightPlane],
     target: &Lobe,
     model: &ReflectionModel,
+    held: Option<&[Rect]>,
 ) -> Vec<PlaneSamples> {
     let target_model = target.model(model);
     let grid = grid_draws(target.water_model(), &target_model);
@@ -134,13 +142,15 @@ pub(super) fn reweighted(
                 .step_by(planes.len())
                 .copied()
                 .collect();
-            reweighted_plane(base, lobes, rays, gauss, target, &target_model)
+            let held = held.and_then(|h| h.get(k)).copied();
+            reweighted_plane(base, lobes, rays, gauss, target, &target_model, held)
         })
         .collect()
 }
 
 /// One plane's samples weighted for `target` (of model `target_model`), its pixels'
-/// Gaussians `gauss` already matched to the target ([`reweighted`]).
+/// Gaussians `gauss` already matched to the target; with `held`, only those whose kernels
+/// reach it ([`reweighted`]).
 fn reweighted_plane(
     base: &PlaneSamples,
     lobes: &[SampleLobe],
@@ -148,6 +158,7 @@ fn reweighted_plane(
     gauss: Vec<LobeGaussian>,
     target: &Lobe,
     target_model: &ReflectionModel,
+    held: Option<Rect>,
 ) -> PlaneSamples {
     let pixels = base.offsets.len() - 1;
     let weights: Vec<f32> = (0..pixels)
@@ -158,6 +169,7 @@ fn reweighted_plane(
             let g = gauss[i];
             let old = &base.weights[r.clone()];
             let points = &base.points[r.clone()];
+            let cells = &base.cells[r.clone()];
             // The target seen from each of the pixel's camera rays, for all their samples.
             let seen: Vec<LobeAt> = rays[i]
                 .iter()
@@ -166,10 +178,14 @@ fn reweighted_plane(
             lobes[r]
                 .iter()
                 .zip(points)
+                .zip(cells)
                 .zip(old)
-                .map(move |((l, q), &w)| {
+                .map(move |(((l, q), h), &w)| {
                     if l.pdf < 0.0 {
                         return w;
+                    }
+                    if held.is_some_and(|r| outside_kernel(*q, *h, &r)) {
+                        return 0.0;
                     }
                     let lobe = match seen.get(l.ray as usize) {
                         Some(at) if l.pdf > 0.0 => at.eval_cos(l.wi) / l.pdf,
@@ -196,6 +212,16 @@ fn reweighted_plane(
         min_size: base.min_size,
         distance: base.distance,
     }
+}
+
+/// Whether a sample at `q` with kernel half-widths `h` (>= 0) covers none of `rect`: where
+/// [`kernel_coverage`](super::kernel::kernel_coverage) is exactly 0 on either axis.
+#[inline]
+fn outside_kernel(q: Vec2, h: Vec2, rect: &Rect) -> bool {
+    q.x + h.x < rect.u_min
+        || q.x - h.x > rect.u_max
+        || q.y + h.y < rect.v_min
+        || q.y - h.y > rect.v_max
 }
 
 #[cfg(test)]
@@ -256,6 +282,11 @@ mod tests {
         }
 
         fn weighted(&self, traced: &Traced, target: Lobe) -> PlaneSamples {
+            self.weighted_held(traced, target, None)
+        }
+
+        /// [`weighted`](Self::weighted), with the light held at `held` where given.
+        fn weighted_held(&self, traced: &Traced, target: Lobe, held: Option<Rect>) -> PlaneSamples {
             let (stored, _, rec) = traced;
             reweighted(
                 &stored[..1],
@@ -266,6 +297,7 @@ mod tests {
                 &[&self.t.light.plane],
                 &target,
                 &self.model,
+                held.as_ref().map(std::slice::from_ref),
             )
             .swap_remove(0)
         }
@@ -348,6 +380,45 @@ mod tests {
 
     const TARGET: [f32; 2] = [2.6e-3, 2.4e-3];
 
+    /// Weighted for a light held at its rectangle (and for one held at a strip 0.3 m wide
+    /// along its left edge), the samples whose kernels cannot reach it weigh 0, most of
+    /// them, and every pixel's coefficient and half-difference of that rectangle are the
+    /// same to the last bit as with every sample weighted.
+    #[test]
+    fn a_held_light_weighs_only_the_samples_its_rectangle_reads() {
+        let c = case();
+        let light = c.t.light.rect();
+        let strip = Rect {
+            u_max: light.u_min + 0.3,
+            ..light
+        };
+        let traced = c.trace(c.waves(TARGET.map(|v| 2.0 * v)), 32, 1);
+        let all = c.weighted(&traced, c.waves(TARGET));
+        let inv = 1.0 / traced.1 as f32;
+        for held in [light, strip] {
+            let some = c.weighted_held(&traced, c.waves(TARGET), Some(held));
+            let zero = |p: &PlaneSamples| p.weights.iter().filter(|&&w| w == 0.0).count();
+            assert!(
+                zero(&some) > zero(&all) + all.weights.len() / 4,
+                "{} of {} samples weigh 0, {} without holding",
+                zero(&some),
+                all.weights.len(),
+                zero(&all)
+            );
+            for i in 0..c.t.pixels.len() {
+                let (a, b) = (
+                    all.coefficient(i, &held, inv),
+                    some.coefficient(i, &held, inv),
+                );
+                assert_eq!(
+                    (a.0.to_bits(), a.1.to_bits()),
+                    (b.0.to_bits(), b.1.to_bits()),
+                    "pixel {i}"
+                );
+            }
+        }
+    }
+
     /// Planes weighted together come out as each weighted alone: the lobe directions a pixel
     /// draws once serve every plane, each with its own Gaussians. The second plane is the
     /// light's face with its origin moved 1 m right and 0.5 m up, so that its samples'
@@ -387,7 +458,7 @@ mod tests {
         let rec = rec.expect("recorded");
         let target = c.waves(TARGET);
         let together = reweighted(
-            &stored, &rec.lobes, &rec.rays, &rec.water, &rec.drew, &planes, &target, &c.model,
+            &stored, &rec.lobes, &rec.rays, &rec.water, &rec.drew, &planes, &target, &c.model, None,
         );
         assert_eq!(together.len(), 2);
         for k in 0..2 {
@@ -400,6 +471,7 @@ mod tests {
                 &planes[k..=k],
                 &target,
                 &c.model,
+                None,
             )
             .swap_remove(0);
             assert!(alone.weights.len() > 10_000, "{}", alone.weights.len());
