@@ -13,6 +13,11 @@
 //! with `S` the joint fit's noise-debiased residual sum of squares, by the same
 //! one-dimensional search over the logarithm, one axis at a time: along, then across, then
 //! along again when across moved (the two interact through the rectangle's corners only).
+//! That last pass is first tried as one Newton step: the fit at the lowest point so far and
+//! one a first step above it along give the gradient, the first along pass's parabola the
+//! curvature, and where the step stays within the search's tolerance its end is the
+//! estimate, one fit instead of two or more ([`newton_along`]); otherwise the pass runs
+//! in full.
 //! Each pass after the first searches from the lowest fit made so far, both axes (the
 //! estimate of the axis it left lies within the search's tolerance of that fit), so the
 //! middle of its first three points is a fit already made: two fits fewer of the eleven a
@@ -350,6 +355,7 @@ pub fn estimate_slopes(
     };
     let (lo_ln, hi_ln) = ((lo as f64).ln(), (hi as f64).ln());
     let show: &dyn Fn(f64) -> String = &|v| format!("{v:.2e}");
+    let mut along_curvature: Option<f64> = None;
     for (pass, axis) in [0usize, 1, 0].into_iter().enumerate() {
         if pass == 2 {
             // Along again only when across moved enough to matter.
@@ -359,6 +365,25 @@ pub fn estimate_slopes(
             }
         }
         let name = ["slope variance along", "slope variance across"][axis];
+        // The fit at variances `v`, made again only if not made yet.
+        let mut point_at = |v: [f32; 2]| -> Result<(Point, Vec<FittedLight>)> {
+            // The same variances to rounding (the logarithm and back).
+            let same = |m: &[f32; 2]| (0..2).all(|a| (m[a] / v[a] - 1.0).abs() < 1e-6);
+            Ok(match made.iter().find(|m| same(&m.0)) {
+                Some((_, p, lights)) => (*p, lights.clone()),
+                None => {
+                    let (p, lights) = eval(v, made.len() + 1)?;
+                    made.push((v, p, lights.clone()));
+                    (p, lights)
+                }
+            })
+        };
+        if pass == 2 {
+            if let Some(v) = newton_along(&mut point_at, anchor, along_curvature, options)? {
+                variance[0] = v;
+                continue;
+            }
+        }
         let pass_points = &mut passes[axis];
         pass_points.clear();
         let found = search(
@@ -369,22 +394,24 @@ pub fn estimate_slopes(
             |x: f64| {
                 let mut v = anchor;
                 v[axis] = x.exp() as f32;
-                // The same variances to rounding (the logarithm and back).
-                let same = |m: &[f32; 2]| (0..2).all(|a| (m[a] / v[a] - 1.0).abs() < 1e-6);
-                let (p, lights) = match made.iter().find(|m| same(&m.0)) {
-                    Some((_, p, lights)) => (*p, lights.clone()),
-                    None => {
-                        let (p, lights) = eval(v, made.len() + 1)?;
-                        made.push((v, p, lights.clone()));
-                        (p, lights)
-                    }
-                };
+                let (p, lights) = point_at(v)?;
                 if p.s.is_finite() {
                     pass_points.push((x, lights));
                 }
                 Ok(Point { x, ..p })
             },
         )?;
+        if pass == 0 {
+            // The curvature of the along pass's parabola, from its sigma and its best fit's
+            // residual variance (`search`'s doc: sigma = sqrt(variance / k)).
+            along_curvature = found.sigma_ln.and_then(|sigma| {
+                let best = made
+                    .iter()
+                    .filter(|m| m.1.s.is_finite())
+                    .min_by(|a, b| a.1.s.total_cmp(&b.1.s))?;
+                (sigma > 0.0).then(|| best.1.variance / (sigma * sigma))
+            });
+        }
         variance[axis] = found.x.exp() as f32;
         if let Some(best) = made
             .iter()
@@ -505,9 +532,81 @@ pub fn estimate_slopes(
     })
 }
 
+/// The along pass after across moved, as one Newton step: the fit at `anchor` (made) and
+/// one a first step above it along, with the first along pass's `curvature` `k` (of `S ~
+/// S0 + k (x - x0)^2` in `x = ln v`), give the gradient and the vertex; the vertex is the
+/// estimate when it lies within the tolerance of the anchor, else `None` (the full pass
+/// runs, and reads the two fits again).
+fn newton_along(
+    point_at: &mut impl FnMut([f32; 2]) -> Result<(Point, Vec<FittedLight>)>,
+    anchor: [f32; 2],
+    curvature: Option<f64>,
+    options: &GlossSearch,
+) -> Result<Option<f32>> {
+    let Some(k) = curvature.filter(|k| k.is_finite() && *k > 0.0) else {
+        return Ok(None);
+    };
+    let (lo, hi) = VARIANCE_RANGE;
+    let x0 = (anchor[0] as f64).ln();
+    let h = options.first_step_ln as f64;
+    if x0 + h > (hi as f64).ln() {
+        return Ok(None);
+    }
+    let (p0, _) = point_at(anchor)?;
+    let (p1, _) = point_at([(x0 + h).exp() as f32, anchor[1]])?;
+    if !(p0.s.is_finite() && p1.s.is_finite()) {
+        return Ok(None);
+    }
+    let g = (p1.s - p0.s - k * h * h) / h;
+    let v = x0 - g / (2.0 * k);
+    Ok(((v - x0).abs() < options.tolerance_ln as f64).then(|| (v.exp() as f32).clamp(lo, hi)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On a cost quadratic in `ln v` along (curvature 40, the across variance playing no
+    /// part), the step from the anchor's fit and one a first step above it lands on the
+    /// vertex when that lies within the tolerance; a vertex farther off, or no curvature,
+    /// gives `None`.
+    #[test]
+    fn the_along_pass_again_is_one_newton_step() {
+        let options = GlossSearch {
+            first_step_ln: 0.3,
+            tolerance_ln: 0.06,
+            ..GlossSearch::default()
+        };
+        let k = 40.0;
+        for (vertex, want) in [(2.95e-3f64, true), (3.25e-3, true), (2.0e-3, false)] {
+            let mut fits = 0;
+            let mut cost = |v: [f32; 2]| -> Result<(Point, Vec<FittedLight>)> {
+                fits += 1;
+                let x = (v[0] as f64).ln();
+                let s = 100.0 + k * (x - vertex.ln()).powi(2);
+                Ok((
+                    Point {
+                        x,
+                        s,
+                        variance: 1.0,
+                    },
+                    Vec::new(),
+                ))
+            };
+            let got = newton_along(&mut cost, [3.1e-3, 2.5e-3], Some(k), &options).unwrap();
+            assert_eq!(fits, 2);
+            match got {
+                Some(v) if want => assert!((v as f64 / vertex - 1.0).abs() < 1e-4, "{v}"),
+                None if !want => {}
+                other => panic!("vertex {vertex}: {other:?}"),
+            }
+        }
+        let mut cost = |_: [f32; 2]| -> Result<(Point, Vec<FittedLight>)> { unreachable!() };
+        assert_eq!(
+            newton_along(&mut cost, [3.1e-3, 2.5e-3], None, &options).unwrap(),
+            None
+        );
+    }
 
     #[test]
     fn totals_and_waves_convert_both_ways() {
