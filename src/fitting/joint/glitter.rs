@@ -97,6 +97,21 @@ pub(super) fn glitter_scales(
     Some((noise, scales))
 }
 
+/// The glitter's noise measured on `st`'s residual ([`glitter_scales`]) and `problem`'s
+/// rows scaled by it ([`scale_rows`]): the scales, or `None` with nothing scaled.
+pub(super) fn weigh(
+    water_model: &dyn WaterModel,
+    scene: &Scene,
+    problem: &mut Problem,
+    st: &State,
+    height: u32,
+) -> Option<Vec<f32>> {
+    let areas = footprint_areas(water_model, scene, problem, height);
+    let (_, scales) = glitter_scales(problem, st, &areas)?;
+    scale_rows(problem, &scales);
+    Some(scales)
+}
+
 /// Least squares of `y` on `a x + b` over `(x, y)`; `None` without a positive `a` (no
 /// glitter term) or with fewer than 16 points. A floor `b` at or below zero is raised to a
 /// thousandth of the mean `y`, so that no pixel's weight is unbounded.

@@ -409,9 +409,7 @@ pub fn fit_joint_with(
     if weights_at_start {
         let mut st = start_state(&problem, start, &extents, options.held, options.resume);
         problem.solve_radiance(&mut st);
-        let areas = glitter::footprint_areas(water_model, scene, &problem, photo.height);
-        if let Some((_, s)) = glitter::glitter_scales(&problem, &st, &areas) {
-            glitter::scale_rows(&mut problem, &s);
+        if let Some(s) = glitter::weigh(water_model, scene, &mut problem, &st, photo.height) {
             let _ = scales_in_force.set(s);
         }
     }
@@ -492,9 +490,7 @@ pub fn fit_joint_with(
     // over the weighted rows.
     let mut scales: Option<Vec<f32>> = scales_in_force.get().cloned();
     if options.glitter_weights && !weights_at_start && scales.is_none() && repeats.len() == 1 {
-        let areas = glitter::footprint_areas(water_model, scene, &problem, photo.height);
-        if let Some((_, s)) = glitter::glitter_scales(&problem, &st, &areas) {
-            glitter::scale_rows(&mut problem, &s);
+        if let Some(s) = glitter::weigh(water_model, scene, &mut problem, &st, photo.height) {
             st = problem.state(
                 st.set_of.clone(),
                 st.pinned.clone(),
