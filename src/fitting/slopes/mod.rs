@@ -404,17 +404,6 @@ pub fn estimate_slopes(
                 Ok(Point { x, ..p })
             },
         )?;
-        if pass == 0 {
-            // The curvature of the along pass's parabola, from its sigma and its best fit's
-            // residual variance (`search`'s doc: sigma = sqrt(variance / k)).
-            along_curvature = found.sigma_ln.and_then(|sigma| {
-                let best = made
-                    .iter()
-                    .filter(|m| m.1.s.is_finite())
-                    .min_by(|a, b| a.1.s.total_cmp(&b.1.s))?;
-                (sigma > 0.0).then(|| best.1.variance / (sigma * sigma))
-            });
-        }
         variance[axis] = found.x.exp() as f32;
         if let Some(best) = made
             .iter()
@@ -422,6 +411,14 @@ pub fn estimate_slopes(
             .min_by(|a, b| a.1.s.total_cmp(&b.1.s))
         {
             anchor = best.0;
+            if pass == 0 {
+                // The curvature of the along pass's parabola, from its sigma and its best
+                // fit's residual variance (`search`'s doc: sigma = sqrt(variance / k)).
+                along_curvature = found
+                    .sigma_ln
+                    .filter(|&sigma| sigma > 0.0)
+                    .map(|sigma| best.1.variance / (sigma * sigma));
+            }
         }
         sigma_ln[axis] = found.sigma_ln.map(|s| s as f32);
         match found.stop {
