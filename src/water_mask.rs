@@ -40,7 +40,9 @@ mod tests {
     /// the 600 x 600 mask, which the cache served.
     #[test]
     fn a_photo_too_large_for_the_cache_gets_the_same_mask() {
-        let (scene, photo, water, _) = crate::samples::fixture("table1.png");
+        let crate::samples::Fixture {
+            scene, photo, water, ..
+        } = crate::samples::fixture("table1.png");
         assert_eq!((photo.width, photo.height), (600, 600));
         let large = water_mask(&scene, 3000, 3000);
         const { assert!(3000 * 3000 > KEPT_PIXELS) };

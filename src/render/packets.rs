@@ -231,7 +231,7 @@ mod tests {
     /// pixel's samples.
     #[test]
     fn a_pixel_in_packets_is_the_pixel_ray_by_ray() {
-        let (scene, _, _, _) = crate::samples::fixture("table1.png");
+        let scene = &crate::samples::fixture("table1.png").scene;
         let camera = &scene.camera;
         // A light facing the camera a little above the middle of the view: some pixels see
         // it, the water below reflects it.

@@ -18,10 +18,14 @@
 //! Table 1's photo as linear float, from the same render as `table1.png` (large, so not
 //! committed).
 
+#[cfg(test)]
+mod fixture;
 pub mod gltf_doc;
 pub mod harbour;
 pub mod harbour_waves;
 mod mesh_size;
+#[cfg(test)]
+pub(crate) use fixture::{fixture, load_fixture, Fixture};
 pub mod shapes;
 pub mod water_surface;
 
@@ -565,38 +569,4 @@ pub fn render_photos(
         }
     }
     Ok(written)
-}
-
-/// Unit-test fixture: the sample scene (written to a temporary folder and loaded), the
-/// committed sample photo `photo` at the samples' exposure, its water mask and its streaks as
-/// the fitters take them.
-#[cfg(test)]
-pub(crate) fn fixture(
-    photo: &str,
-) -> (
-    crate::scene_in::Scene,
-    crate::photo_in::Photo,
-    Vec<bool>,
-    Vec<crate::fitting::StreakObservation>,
-) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = std::env::temp_dir().join(format!(
-        "streaklight-fixture-{}-{:?}",
-        std::process::id(),
-        std::thread::current().id()
-    ));
-    write_scenes(&dir).expect("sample scenes");
-    let scene = crate::scene_in::load(&dir.join("scene.gltf"), &Default::default()).expect("scene");
-    let _ = std::fs::remove_dir_all(&dir);
-    let photo =
-        crate::photo_in::load(&root.join("samples").join(photo), PHOTO_EXPOSURE).expect("photo");
-    let water = crate::water_mask::water_mask(&scene, photo.width, photo.height);
-    let segmented =
-        crate::streaks::extract_streaks(&photo, &water, &Default::default()).expect("streaks");
-    let observations = segmented
-        .streaks
-        .iter()
-        .map(|s| crate::pipeline::observation(s, photo.width))
-        .collect();
-    (scene, photo, water, observations)
 }

@@ -293,7 +293,12 @@ mod tests {
     /// served the old hits. Each answer is checked against the tracer itself.
     #[test]
     fn kept_boxes_serve_only_what_they_hold() {
-        let (mut scene, photo, water, _) = crate::samples::fixture("table1.png");
+        let crate::samples::Fixture {
+            mut scene,
+            photo,
+            water,
+            ..
+        } = crate::samples::load_fixture("table1.png");
         let size = photo.width;
         assert_eq!(photo.height, size);
         // The fixture's water mask traced the whole image: start with nothing kept.

@@ -52,7 +52,12 @@ impl WaterModel for Delegating {
 
 #[test]
 fn a_delegating_model_gives_the_exact_models_fits() {
-    let (scene, photo, water, observations) = crate::samples::fixture("table1.png");
+    let crate::samples::Fixture {
+        scene,
+        photo,
+        water,
+        observations,
+    } = crate::samples::fixture("table1.png");
     let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
     let options = FitOptions {
         samples: 64,

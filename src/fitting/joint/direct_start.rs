@@ -200,7 +200,8 @@ pub(super) mod tests {
 
     /// Table 1's scene and photo (one 3 m x 3 m light on the wall, in frame), the wall as a
     /// light plane, and the light's true rectangle on it (from the sample's definition).
-    pub(in crate::fitting::joint) fn table1() -> (Scene, Photo, Vec<bool>, LightPlane, Rect) {
+    pub(in crate::fitting::joint) fn table1(
+    ) -> (&'static Scene, &'static Photo, &'static [bool], LightPlane, Rect) {
         let (scene, photo, water, plane) = crate::fitting::joint::direct::tests::table1_wall();
         let truth = crate::samples::table1_light();
         let at = |x: f64, y: f64| {
@@ -322,7 +323,7 @@ pub(super) mod tests {
             angle * far
         );
         let (top, _) = image_rows(&photo, &water);
-        let mut cut = water.clone();
+        let mut cut = water.to_vec();
         let w = photo.width as usize;
         cut[(top - 1) * w..top * w]
             .iter_mut()
@@ -379,7 +380,7 @@ pub(super) mod tests {
                 && (got.v_max - truth.v_max).abs() < footprint,
             "{got:?} against {truth:?}"
         );
-        let mut cut = water.clone();
+        let mut cut = water.to_vec();
         let row = (top - 1) * photo.width as usize;
         cut[row..row + photo.width as usize].fill(true);
         let out = direct_starts(&scene, &photo, &cut, &[light(&plane, tall, 0)]);

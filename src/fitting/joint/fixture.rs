@@ -14,7 +14,7 @@ use crate::water_model::ExactSurface;
 /// Table 3's photo and scene, light0 as the paper fits it, and every 8th pixel of its
 /// fitted region: what the tests that trace samples read.
 pub(super) struct Table3Light0 {
-    pub(super) scene: crate::scene_in::Scene,
+    pub(super) scene: &'static crate::scene_in::Scene,
     pub(super) model: ReflectionModel,
     pub(super) light: FittedLight,
     pub(super) roi: Rect,
@@ -23,8 +23,19 @@ pub(super) struct Table3Light0 {
     pub(super) height: u32,
 }
 
-pub(super) fn table3_light0() -> Table3Light0 {
-    let (scene, photo, water, observations) = crate::samples::fixture("table3.png");
+/// The fixture, made once per test process and shared by the tests that read it.
+pub(super) fn table3_light0() -> &'static Table3Light0 {
+    static MADE: std::sync::OnceLock<Table3Light0> = std::sync::OnceLock::new();
+    MADE.get_or_init(make_table3_light0)
+}
+
+fn make_table3_light0() -> Table3Light0 {
+    let crate::samples::Fixture {
+        scene,
+        photo,
+        water,
+        observations,
+    } = crate::samples::fixture("table3.png");
     let model = ReflectionModel::new(scene.water.gloss, scene.water.ior);
     let options = crate::fitting::FitOptions {
         samples: 256,

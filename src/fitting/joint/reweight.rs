@@ -236,7 +236,7 @@ mod tests {
     /// Table 3's light0, under the statistical water of Table 3's mean plane or over the
     /// scene's own waves.
     struct Case {
-        t: Table3Light0,
+        t: &'static Table3Light0,
         model: ReflectionModel,
         surface: crate::water_model::MeanSurface,
     }

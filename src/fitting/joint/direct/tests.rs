@@ -7,14 +7,17 @@ use crate::samples::PHOTO_SIZE;
 
 /// The samples' scene (camera at (0, 0.2, 10) looking down -z, the wall at z = 0 facing it),
 /// its water mask, and the wall as a light plane, found by the camera ray through `pixel`.
-fn wall() -> (Scene, Vec<bool>, LightPlane) {
+fn wall() -> (&'static Scene, &'static [bool], LightPlane) {
     let (scene, _, water, plane) = table1_wall();
     (scene, water, plane)
 }
 
 /// [`wall`] with Table 1's photo (one 3 m x 3 m light on that wall, in frame).
-pub(in crate::fitting::joint) fn table1_wall() -> (Scene, Photo, Vec<bool>, LightPlane) {
-    let (scene, photo, water, _) = crate::samples::fixture("table1.png");
+pub(in crate::fitting::joint) fn table1_wall(
+) -> (&'static Scene, &'static Photo, &'static [bool], LightPlane) {
+    let crate::samples::Fixture {
+        scene, photo, water, ..
+    } = crate::samples::fixture("table1.png");
     assert_eq!((photo.width, photo.height), (PHOTO_SIZE, PHOTO_SIZE));
     let origin = scene.camera.position;
     let dir = scene.camera.direction(300.5, 100.5, PHOTO_SIZE, PHOTO_SIZE);
