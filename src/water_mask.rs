@@ -41,10 +41,13 @@ mod tests {
     #[test]
     fn a_photo_too_large_for_the_cache_gets_the_same_mask() {
         let crate::samples::Fixture {
-            scene, photo, water, ..
+            scene,
+            photo,
+            water,
+            ..
         } = crate::samples::fixture("table1.png");
         assert_eq!((photo.width, photo.height), (600, 600));
-        let large = water_mask(&scene, 3000, 3000);
+        let large = water_mask(scene, 3000, 3000);
         const { assert!(3000 * 3000 > KEPT_PIXELS) };
         let mut differ = 0;
         for y in 0..600 {

@@ -255,7 +255,7 @@ mod tests {
         for (camera_rays, lobe_samples) in [(16, 4), (3, 1), (9, 2)] {
             for y in (0..h).step_by(11) {
                 for x in (0..w).step_by(11) {
-                    match camera_hit(&scene, &lights, x as f32 + 0.5, y as f32 + 0.5, w, h) {
+                    match camera_hit(scene, &lights, x as f32 + 0.5, y as f32 + 0.5, w, h) {
                         CameraHit::Water(_) => seen[0] += 1,
                         CameraHit::Light(_) => seen[1] += 1,
                         CameraHit::Other => seen[2] += 1,
@@ -263,7 +263,7 @@ mod tests {
                     let index = (y * w + x) as u64;
                     let mut rng = Rng::new(7, index);
                     let packets = black_night_pixel(
-                        &scene,
+                        scene,
                         &lights,
                         &model,
                         None,
@@ -285,7 +285,7 @@ mod tests {
                             lobe_samples,
                         };
                         let (value, n) = pixel_sample(
-                            &scene, &lights, &model, None, None, sample, w, h, &mut rng,
+                            scene, &lights, &model, None, None, sample, w, h, &mut rng,
                         );
                         traced += n as u64;
                         for c in 0..3 {

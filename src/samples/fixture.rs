@@ -21,8 +21,7 @@ pub(crate) struct Fixture {
 /// that read it (the scene's lazily built parts and caches give the same answers to every
 /// reader). A test that changes the scene makes its own with [`load_fixture`].
 pub(crate) fn fixture(photo: &str) -> &'static Fixture {
-    static MADE: Mutex<BTreeMap<String, &'static OnceLock<Fixture>>> =
-        Mutex::new(BTreeMap::new());
+    static MADE: Mutex<BTreeMap<String, &'static OnceLock<Fixture>>> = Mutex::new(BTreeMap::new());
     let cell: &'static OnceLock<Fixture> = {
         let mut made = MADE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         made.entry(photo.to_string())

@@ -66,8 +66,8 @@ fn a_delegating_model_gives_the_exact_models_fits() {
     };
 
     let delegating = Delegating::default();
-    let exact = fit_paper(&scene, &photo, &water, &observations, &options).expect("paper fit");
-    let other = fit_paper_with(&delegating, &scene, &photo, &water, &observations, &options)
+    let exact = fit_paper(scene, photo, water, observations, &options).expect("paper fit");
+    let other = fit_paper_with(&delegating, scene, photo, water, observations, &options)
         .expect("paper fit");
     assert!(!exact.lights.is_empty(), "the paper fit finds the light");
     assert_eq!(other.lights, exact.lights);
@@ -83,20 +83,20 @@ fn a_delegating_model_gives_the_exact_models_fits() {
         ..JointOptions::new(model, 1)
     };
     let exact_joint = fit_joint(
-        &scene,
-        &photo,
-        &water,
-        &observations,
+        scene,
+        photo,
+        water,
+        observations,
         &exact.lights,
         &joint_options,
     )
     .expect("joint fit");
     let other_joint = fit_joint_with(
         &delegating,
-        &scene,
-        &photo,
-        &water,
-        &observations,
+        scene,
+        photo,
+        water,
+        observations,
         &exact.lights,
         &joint_options,
     )

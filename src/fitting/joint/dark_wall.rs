@@ -163,7 +163,7 @@ mod tests {
             }
             light
         };
-        let got = trimmed_to_unseen_wall(&scene, &photo, &water, &start(low, true)).rect();
+        let got = trimmed_to_unseen_wall(scene, photo, water, &start(low, true)).rect();
         let cell = low.height() / GRID as f32;
         let footprint = 10.0 * 2.0 * (30f32.to_radians()).tan() / photo.height as f32;
         assert!(
@@ -177,7 +177,7 @@ mod tests {
             (low.u_min, low.u_max, low.v_max)
         );
 
-        let fitted = trimmed_to_unseen_wall(&scene, &photo, &water, &start(low, false));
+        let fitted = trimmed_to_unseen_wall(scene, photo, water, &start(low, false));
         assert_eq!(fitted.rect(), low);
 
         // Three quarters of it on the black wall below the light, a quarter on the light.
@@ -186,7 +186,7 @@ mod tests {
             v_max: truth.v_min + 0.6,
             ..truth
         };
-        let dark = trimmed_to_unseen_wall(&scene, &photo, &water, &start(below, true));
+        let dark = trimmed_to_unseen_wall(scene, photo, water, &start(below, true));
         assert_eq!(dark.rect(), below);
     }
 }

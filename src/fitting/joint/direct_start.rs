@@ -200,8 +200,13 @@ pub(super) mod tests {
 
     /// Table 1's scene and photo (one 3 m x 3 m light on the wall, in frame), the wall as a
     /// light plane, and the light's true rectangle on it (from the sample's definition).
-    pub(in crate::fitting::joint) fn table1(
-    ) -> (&'static Scene, &'static Photo, &'static [bool], LightPlane, Rect) {
+    pub(in crate::fitting::joint) fn table1() -> (
+        &'static Scene,
+        &'static Photo,
+        &'static [bool],
+        LightPlane,
+        Rect,
+    ) {
         let (scene, photo, water, plane) = crate::fitting::joint::direct::tests::table1_wall();
         let truth = crate::samples::table1_light();
         let at = |x: f64, y: f64| {
@@ -270,9 +275,9 @@ pub(super) mod tests {
             v_max: c.y + 6.0,
         };
         let out = direct_starts(
-            &scene,
-            &photo,
-            &water,
+            scene,
+            photo,
+            water,
             &[light(&plane, thin, 0), light(&plane, fragment, 1)],
         );
         assert_eq!(out.len(), 1, "the fragment merges");
@@ -282,7 +287,7 @@ pub(super) mod tests {
         assert_within(&got, &truth, footprint);
 
         let inside = truth.grow(-0.3);
-        let kept = direct_starts(&scene, &photo, &water, &[light(&plane, inside, 0)]);
+        let kept = direct_starts(scene, photo, water, &[light(&plane, inside, 0)]);
         assert_eq!(kept.len(), 1);
         assert_eq!(kept[0].rect(), inside);
     }
@@ -299,7 +304,7 @@ pub(super) mod tests {
         let footprint = 10.0 * 2.0 * (30f32.to_radians()).tan() / photo.height as f32;
         let start = light(&plane, truth.grow(-0.3), 0);
         let (image, measured) =
-            enclosing_image(&scene, &photo, &water, &start).expect("a whole image");
+            enclosing_image(scene, photo, water, &start).expect("a whole image");
         assert_within(&image, &truth, footprint);
         // A pixel's angle times the camera's distance, between the light's nearest corner
         // and its farthest.
@@ -322,19 +327,19 @@ pub(super) mod tests {
             angle * near,
             angle * far
         );
-        let (top, _) = image_rows(&photo, &water);
+        let (top, _) = image_rows(photo, water);
         let mut cut = water.to_vec();
         let w = photo.width as usize;
         cut[(top - 1) * w..top * w]
             .iter_mut()
             .for_each(|m| *m = true);
-        assert!(enclosing_image(&scene, &photo, &cut, &start).is_none());
+        assert!(enclosing_image(scene, photo, &cut, &start).is_none());
         let off = Rect {
             u_min: truth.u_max + 3.0,
             u_max: truth.u_max + 4.0,
             ..truth
         };
-        assert!(enclosing_image(&scene, &photo, &water, &light(&plane, off, 0)).is_none());
+        assert!(enclosing_image(scene, photo, water, &light(&plane, off, 0)).is_none());
     }
 
     /// A start that overlaps the light's image well but reaches beyond it (as a grazing
@@ -353,12 +358,12 @@ pub(super) mod tests {
             ..truth
         };
         for start in [tall, truth.grow(0.2)] {
-            let out = direct_starts(&scene, &photo, &water, &[light(&plane, start, 0)]);
+            let out = direct_starts(scene, photo, water, &[light(&plane, start, 0)]);
             assert_eq!(out.len(), 1);
             let got = out[0].rect();
             assert_within(&got, &truth, footprint);
         }
-        let (top, bottom) = image_rows(&photo, &water);
+        let (top, bottom) = image_rows(photo, water);
         // Two stacked lamps: the image cut in two by three dark rows across its middle. A
         // start over both, reaching 0.2 m beyond them (overlapping each by more than a
         // quarter), is trimmed to both, not to the one nearer its centre.
@@ -368,12 +373,7 @@ pub(super) mod tests {
             stacked.radiance[i] = [0.0; 3];
             stacked.clipped[i] = false;
         }
-        let out = direct_starts(
-            &scene,
-            &stacked,
-            &water,
-            &[light(&plane, truth.grow(0.2), 0)],
-        );
+        let out = direct_starts(scene, &stacked, water, &[light(&plane, truth.grow(0.2), 0)]);
         let got = out[0].rect();
         assert!(
             (got.v_min - truth.v_min).abs() < footprint
@@ -383,7 +383,7 @@ pub(super) mod tests {
         let mut cut = water.to_vec();
         let row = (top - 1) * photo.width as usize;
         cut[row..row + photo.width as usize].fill(true);
-        let out = direct_starts(&scene, &photo, &cut, &[light(&plane, tall, 0)]);
+        let out = direct_starts(scene, photo, &cut, &[light(&plane, tall, 0)]);
         assert_eq!(out[0].rect(), tall);
     }
 

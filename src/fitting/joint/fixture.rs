@@ -42,19 +42,19 @@ fn make_table3_light0() -> Table3Light0 {
         seed: 1,
         model,
     };
-    let paper = crate::fitting::fit_paper(&scene, &photo, &water, &observations, &options)
-        .expect("paper fit");
+    let paper =
+        crate::fitting::fit_paper(scene, photo, water, observations, &options).expect("paper fit");
     let light = paper.lights[0].clone();
     let roi = region_of_interest(&light, None);
     let used: Vec<&StreakObservation> = observations.iter().collect();
     let pixels: Vec<u32> = region(
         &ExactSurface,
-        &scene,
+        scene,
         &model,
         &[&light.plane],
         &[roi],
-        &photo,
-        &water,
+        photo,
+        water,
         &used,
         6,
         super::PixelShare::Checkerboard,
@@ -83,7 +83,7 @@ impl Table3Light0 {
     ) -> (Vec<PlaneSamples>, u32) {
         trace_samples(
             &ExactSurface,
-            &self.scene,
+            self.scene,
             &self.model,
             &[&self.light.plane],
             &[self.roi],

@@ -243,7 +243,7 @@ mod tests {
 
     fn case() -> Case {
         let t = table3_light0();
-        let stats = water_statistics(&t.scene, t.width, t.height).expect("water");
+        let stats = water_statistics(t.scene, t.width, t.height).expect("water");
         Case {
             model: ReflectionModel::new(MICROFACET_GLOSS, t.model.ior),
             surface: stats.surface,
@@ -266,7 +266,7 @@ mod tests {
             let t = &self.t;
             let (stored, n, recorded) = trace_recorded(
                 lobe.water_model(),
-                &t.scene,
+                t.scene,
                 &lobe.model(&self.model),
                 &[&t.light.plane],
                 &[t.roi],
@@ -443,7 +443,7 @@ mod tests {
         let proposal = c.waves(TARGET.map(|v| 2.0 * v));
         let (stored, _, rec) = trace_recorded(
             proposal.water_model(),
-            &t.scene,
+            t.scene,
             &proposal.model(&c.model),
             &planes,
             &[t.roi, moved_roi],

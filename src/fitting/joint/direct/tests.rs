@@ -16,7 +16,10 @@ fn wall() -> (&'static Scene, &'static [bool], LightPlane) {
 pub(in crate::fitting::joint) fn table1_wall(
 ) -> (&'static Scene, &'static Photo, &'static [bool], LightPlane) {
     let crate::samples::Fixture {
-        scene, photo, water, ..
+        scene,
+        photo,
+        water,
+        ..
     } = crate::samples::fixture("table1.png");
     assert_eq!((photo.width, photo.height), (PHOTO_SIZE, PHOTO_SIZE));
     let origin = scene.camera.position;
@@ -79,8 +82,8 @@ fn a_direct_pixel_sees_the_fraction_of_its_footprint_inside_the_light() {
     // 0.7 x 0.4 = 28 %.
     let (scene, _, plane) = wall();
     let (x, y) = (150u32, 100u32);
-    let top_left = corner(&scene, &plane, x as f32, y as f32);
-    let bottom_right = corner(&scene, &plane, x as f32 + 1.0, y as f32 + 1.0);
+    let top_left = corner(scene, &plane, x as f32, y as f32);
+    let bottom_right = corner(scene, &plane, x as f32 + 1.0, y as f32 + 1.0);
     let side = bottom_right.x - top_left.x;
     // u grows to the right, v upwards: the image's rows grow downwards.
     assert!(side > 0.0 && (top_left.y - bottom_right.y - side).abs() < 1e-3 * side);
@@ -96,7 +99,7 @@ fn a_direct_pixel_sees_the_fraction_of_its_footprint_inside_the_light() {
         ..straddling_left
     };
     for (rect, exact) in [(straddling_left, 0.7), (corner_rect, 0.28)] {
-        let c = coefficient(&scene, &plane, &rect, x, y);
+        let c = coefficient(scene, &plane, &rect, x, y);
         assert!((c - exact).abs() < 1e-3, "{c} against {exact}");
     }
     // The share follows the edge linearly across the pixel, and is 0 and 1 beyond it.
@@ -106,7 +109,7 @@ fn a_direct_pixel_sees_the_fraction_of_its_footprint_inside_the_light() {
             u_min: top_left.x + f * side,
             ..straddling_left
         };
-        let c = coefficient(&scene, &plane, &rect, x, y);
+        let c = coefficient(scene, &plane, &rect, x, y);
         let exact = (1.0 - f as f64).clamp(0.0, 1.0);
         assert!((c - exact).abs() < 1e-3, "edge at {f}: {c} against {exact}");
     }
@@ -116,16 +119,7 @@ fn a_direct_pixel_sees_the_fraction_of_its_footprint_inside_the_light() {
         ..plane.clone()
     };
     let roi = straddling_left.grow(5.0);
-    let hits = direct_hits(
-        &scene,
-        &[&behind],
-        &[roi],
-        x,
-        y,
-        PHOTO_SIZE,
-        PHOTO_SIZE,
-        1.0,
-    );
+    let hits = direct_hits(scene, &[&behind], &[roi], x, y, PHOTO_SIZE, PHOTO_SIZE, 1.0);
     assert!(hits.is_empty(), "{} rays through the wall", hits.len());
 }
 
@@ -145,12 +139,12 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
     // Grown by 0.9 m: inside the photo, whose top row sees the wall at y = 5.97 m.
     let roi = rect.grow(0.9);
     let pixels = direct_pixels(
-        &scene,
+        scene,
         &[&plane],
         &[roi],
         PHOTO_SIZE,
         PHOTO_SIZE,
-        &water,
+        water,
         PixelShare::Checkerboard,
     );
     // 4.8 x 4.8 m at 10 m, 600 pixels over 2 tan(30 deg) 10 m: about 250 pixels a side, half of
@@ -173,12 +167,12 @@ fn direct_pixels_are_the_wall_around_a_light_in_frame_and_none_out_of_it() {
         ..rect
     };
     let none = direct_pixels(
-        &scene,
+        scene,
         &[&plane],
         &[above],
         PHOTO_SIZE,
         PHOTO_SIZE,
-        &water,
+        water,
         PixelShare::Checkerboard,
     );
     assert!(none.is_empty(), "{} pixels", none.len());
