@@ -344,8 +344,8 @@ fn repeated_fits_cover_the_stacked_errors() {
 /// share a streak are held here: the warning, what the report says the refit read, the
 /// edges the cut made unconstrained and the outer ones the merged light's. Over e = 500
 /// water (`stacked.png`) the photo tells the lights apart only weakly: through the whole
-/// pipeline over fit seeds 1-10 the lower light's top is 7.3 % rms off and the upper one's
-/// bottom 8.0 % (BENCHMARKS.md, "From the reflections alone"), and `repeated_fits_cover_the_stacked_errors` holds its fit. From the reflections alone (without the
+/// pipeline over fit seeds 1-10 the lower light's top is 4.0 % rms off and the upper one's
+/// bottom 3.9 % (BENCHMARKS.md, "From the reflections alone"), and `repeated_fits_cover_the_stacked_errors` holds its fit. From the reflections alone (without the
 /// direct view) and otherwise at the default settings, the joint fit, having split the streak, fits again over every pixel with 128 samples, and both lights
 /// come out within 2 % for every edge and the radiance: over fit seeds 1-8
 /// (`cargo bench --bench spread`, BENCHMARKS.md) the largest error of any

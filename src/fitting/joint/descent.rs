@@ -95,11 +95,18 @@ impl Problem {
         near: &[bool],
         pattern: bool,
     ) {
+        let mut windows = self.descent_windows(st, near);
+        self.descend_windows(st, extents, sweeps, &mut windows, pattern);
+    }
+
+    /// The search windows a descent of `st` starts with (see [`Self::descend_near`] for
+    /// `near`): [`Self::descend_windows`] carries on from them.
+    pub(super) fn descent_windows(&self, st: &State, near: &[bool]) -> Windows {
         // Initial half-windows: see `first_window`; a few pixel footprints for a light its
         // direct image pins on every side (`image_bounds`), which lies within about one of
         // its optimum already.
         let bounds = self.image_bounds(st);
-        let mut windows: Vec<[f32; 4]> = st
+        let windows: Vec<[f32; 4]> = st
             .rects
             .iter()
             .zip(&st.set_of)
@@ -120,9 +127,39 @@ impl Problem {
                 }
             })
             .collect();
-        let min_windows: Vec<f32> = st.rects.iter().map(min_window).collect();
+        let least: Vec<f32> = st.rects.iter().map(min_window).collect();
+        Windows {
+            half: windows,
+            least,
+            sweeps: 0,
+        }
+    }
+
+    /// Up to `sweeps` more sweeps of the descent whose search windows are `w` (the state
+    /// `st` they were made for, moved only by descents through them): a descent cut in two
+    /// this way ends where one of the summed sweeps does. Returns whether it converged
+    /// (every window at its least).
+    pub(super) fn descend_windows(
+        &self,
+        st: &mut State,
+        extents: &[Option<Rect>],
+        sweeps: u32,
+        w: &mut Windows,
+        pattern: bool,
+    ) -> bool {
+        let Windows {
+            half: windows,
+            least: min_windows,
+            sweeps: done,
+        } = w;
         let grid = GRID;
-        for sweep in 0..sweeps {
+        for _ in 0..sweeps {
+            // Checked after each sweep, as the first sweep runs whatever the windows.
+            if *done > 0 && all_least(windows, min_windows) {
+                return true;
+            }
+            let sweep = *done;
+            *done += 1;
             let sweep_start = st.rects.clone();
             for k in 0..st.rects.len() {
                 let Some(ext) = extents[st.set_of[k]] else {
@@ -174,17 +211,28 @@ impl Problem {
             }
             self.solve_radiance(st);
             if pattern && sweep >= 1 {
-                self.pattern_move(st, extents, &sweep_start, &min_windows);
-            }
-            if windows
-                .iter()
-                .zip(&min_windows)
-                .all(|(w, &least)| w.iter().all(|&w| w <= least))
-            {
-                break;
+                self.pattern_move(st, extents, &sweep_start, min_windows);
             }
         }
+        all_least(windows, min_windows)
     }
+}
+
+/// Whether every search half-window in `half` is down to its light's least.
+fn all_least(half: &[[f32; 4]], least: &[f32]) -> bool {
+    half.iter()
+        .zip(least)
+        .all(|(w, &least)| w.iter().all(|&w| w <= least))
+}
+
+/// A descent's search windows, to carry it on ([`Problem::descent_windows`]).
+pub(super) struct Windows {
+    /// Per light, each edge's search half-window.
+    half: Vec<[f32; 4]>,
+    /// Per light, the least half-window ([`min_window`]).
+    least: Vec<f32>,
+    /// Sweeps made.
+    sweeps: u32,
 }
 
 /// How far a pattern move tries to carry a sweep's displacement, in multiples of it: each
@@ -320,5 +368,52 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A descent carried on through its windows ([`Problem::descend_windows`], as the split's
+    /// trial does when its split does not pay yet) ends where the whole descent does, to the
+    /// last bit, with and without pattern moves; and one that converged says so and stays.
+    #[test]
+    fn a_descent_cut_in_two_ends_where_the_whole_one_does() {
+        let t = table3_light0();
+        let (planes, n) = t.trace(72, 1, 0, true);
+        let truth = t.light.rect();
+        let problem = t.problem(planes, 1.0 / n as f32, &truth);
+        let extents = vec![sample_extent(&problem.planes[0])];
+        let h = truth.height();
+        let start = truth
+            .with_edge(EdgeSide::Bottom, truth.v_min - 0.1 * h)
+            .with_edge(EdgeSide::Top, truth.v_max + 0.1 * h);
+        let st = problem.state(vec![0], vec![[false; 4]], vec![start], vec![[1.0; 3]]);
+        for pattern in [false, true] {
+            let mut whole = st.clone();
+            let mut w = problem.descent_windows(&whole, &[]);
+            let whole_converged = problem.descend_windows(&mut whole, &extents, 8, &mut w, pattern);
+            let mut cut = st.clone();
+            let mut w = problem.descent_windows(&cut, &[]);
+            let first = problem.descend_windows(&mut cut, &extents, 3, &mut w, pattern);
+            assert!(!first, "3 sweeps from a fifth too tall do not converge");
+            let second = problem.descend_windows(&mut cut, &extents, 5, &mut w, pattern);
+            assert_eq!(second, whole_converged);
+            assert_eq!(cut.rects, whole.rects, "pattern moves: {pattern}");
+            assert_eq!(cut.radiance, whole.radiance, "pattern moves: {pattern}");
+            assert_ne!(cut.rects[0], start, "the descent moved");
+            if pattern {
+                let mut plain = st.clone();
+                problem.descend_with_pattern_moves(&mut plain, &extents, 8);
+                assert_eq!(plain.rects, whole.rects);
+            } else {
+                let mut plain = st.clone();
+                problem.descend(&mut plain, &extents, 8);
+                assert_eq!(plain.rects, whole.rects);
+            }
+        }
+        // Carried on to convergence, a descent reports it and moves no more.
+        let mut done = st.clone();
+        let mut w = problem.descent_windows(&done, &[]);
+        assert!(problem.descend_windows(&mut done, &extents, 40, &mut w, false));
+        let before = done.rects.clone();
+        assert!(problem.descend_windows(&mut done, &extents, 5, &mut w, false));
+        assert_eq!(done.rects, before);
     }
 }
