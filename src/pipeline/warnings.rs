@@ -100,8 +100,8 @@ pub(super) fn shares_a_streak(lights: &[FittedLight], seen: &[bool]) -> bool {
 /// streaks) and that the reflections alone must tell apart ([`lights_by_shared_streak`]):
 /// the photo tells such lights apart only weakly, so their facing edges and
 /// radiances can be off by several percent (on the bundled stacked sample from the
-/// reflections alone, even with the refit over every pixel, 4-5 % rms over 10 seeds and up
-/// to 9.4 % on one: BENCHMARKS.md, "From the reflections alone"). Their reported
+/// reflections alone, even with the refit over every pixel, 4-6 % rms over 20 seeds and up
+/// to 11 % on one: BENCHMARKS.md, "From the reflections alone"). Their reported
 /// uncertainties are as wide; the warning says why. Unless the fit already read every pixel
 /// with at least [`THOROUGH`]'s samples (`thorough`), it also says how to fit such lights
 /// more closely. Lights are named by [`light_name`] of their index.

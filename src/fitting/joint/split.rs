@@ -11,8 +11,10 @@ use crate::progress::Reporter;
 /// enough: few on purpose. The two halves of a trial read one sample set, and the longer they
 /// descend the further their common boundary follows that set's noise, which the boundary
 /// search then starts from. Measured on the stacked sample from the reflections alone over
-/// fit seeds 1-10: with 3 sweeps the facing edges and radiances 3.9-4.8 % rms off (9.4 % at
-/// worst), with 8 sweeps 7.3-8.4 % (22.8 %) (BENCHMARKS.md, "From the reflections alone").
+/// fit seeds 1-20: with 3 sweeps the facing edges and radiances 4.1-5.6 % rms off (11.3 % at
+/// worst), with 8 sweeps 6.6-16.3 % (43.8 %, four seeds beyond 20 %); over e = 1000 water
+/// (seeds 1-8) 1.2 % rms at worst with 3, 1.1 % with 8 (BENCHMARKS.md, "From the
+/// reflections alone").
 const SPLIT_TRIAL_SWEEPS: u32 = 3;
 
 /// Sweeps the trial goes on to when after [`SPLIT_TRIAL_SWEEPS`] the split does not pay yet:
