@@ -340,9 +340,9 @@ mod tests {
 
     /// From [`too_tall_start`], which lies in the valley along which the light's height trades
     /// against its radiance: with pattern moves the descent ends at no higher a cost than the
-    /// plain one in every number of sweeps, and after 5 sweeps it is within a quarter of the plain
-    /// descent's distance from the cost both reach at 14 (measured: 0.06 of it; the plain
-    /// descent needs 8 sweeps for what the pattern moves reach in 5).
+    /// plain one in every number of sweeps, and after 5 sweeps it is within a quarter of the
+    /// plain descent's distance from the cost both reach at 14 (measured: 0.06 of it; the
+    /// plain descent needs 8 sweeps for what the pattern moves reach in 5).
     #[test]
     fn pattern_moves_carry_a_light_along_its_valley() {
         let (problem, extents, st, h) = too_tall_start();

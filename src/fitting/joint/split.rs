@@ -66,9 +66,10 @@ pub struct Split {
 /// other, side by side; overlapping streaks merge into one region, method §5 and the paper's
 /// §5.3): each candidate starts from the rectangle cut in half and is fitted coarsely, the
 /// other lights held ([`SPLIT_TRIAL_SWEEPS`] sweeps, on to [`SPLIT_TRIAL_MAX_SWEEPS`] when
-/// the split does not pay by then). Returns the candidate with the lowest row-summed cost when it is below
-/// [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, its way, and the two edges that
-/// face each other (the first light's, then the second's, the new light last in the state).
+/// the split does not pay by then). Returns the candidate with the lowest row-summed cost
+/// among those below [`SPLIT_MIN_ROW_COST_RATIO`] times the unsplit state's, its way, and the
+/// two edges that face each other (the first light's, then the second's, the new light last
+/// in the state).
 /// This only decides whether and which way to split: where the two lights meet is
 /// [`search_boundary`](super::boundary::search_boundary)'s work. `progress` hears the count of
 /// ways tried (each a descent of the two halves: about a second on the stacked sample).
