@@ -130,7 +130,8 @@ pub(super) fn try_split(
             let c = problem.row_cost(trial);
             (both_lit && c < SPLIT_MIN_ROW_COST_RATIO * before).then_some(c)
         };
-        if !converged && pays(&trial).is_none() {
+        let mut paid = pays(&trial);
+        if !converged && paid.is_none() {
             problem.descend_windows(
                 &mut trial,
                 extents,
@@ -138,9 +139,10 @@ pub(super) fn try_split(
                 &mut windows,
                 false,
             );
+            paid = pays(&trial);
         }
         trial.pinned = pinned;
-        let Some(c) = pays(&trial) else {
+        let Some(c) = paid else {
             continue;
         };
         if best.as_ref().is_none_or(|(_, _, _, b)| c < *b) {
