@@ -1,10 +1,12 @@
-//! The harbour pair (docs/method.md §10; README, "Sample photos") fitted at the defaults: over
-//! the photo's own waves the exact model is kept, over another realisation of the same waves
-//! the statistical model is chosen, and both give the two lights (an orange 4 x 2 m and a blue
-//! 3 x 1.5 m light 40 m from a camera 2 m above the water; their direct images clip some
-//! channels, not others) within 3 % of their size in every edge and 3 % of their radiance in
-//! every channel (the statistical-water issue's bar; measured: 0.10 % and 0.5 % exact, 0.08 %
-//! and 0.6 % statistical).
+//! The harbour layouts (docs/method.md §10; README, "Sample photos") fitted at the defaults
+//! with their lamps in frame: over the photo's own waves the exact model is kept, over
+//! another realisation of the same waves and over the flat quad a game scene holds the
+//! statistical model is chosen, and every light (the pair: an orange 4 x 2 m and a blue
+//! 3 x 1.5 m light 40 m from a camera 2 m above the water; three lights of different sizes
+//! and colours; a warm white sign) comes out within 3 % of its size in every edge, and, where
+//! its image leaves a channel unclipped, within 3 % of its radiance in every channel (the
+//! statistical water's bar; measured on the pair: 0.10 % and 0.5 % exact, 0.08 % and 0.6 %
+//! statistical). The lamps out of frame are `tests/far_lights.rs`'.
 
 mod common;
 
@@ -19,21 +21,28 @@ use streaklight::samples::{self, harbour};
 use streaklight::scene_in::Scene;
 use streaklight::water_model::water_statistics;
 
-/// Every truth light of the pair has one fitted light whose edges are within 3 % of its size
-/// and whose radiance is within 3 % per channel; no other light. Both lamps' images show
-/// their weak channels unclipped, so their radiances are read off them: every channel's
-/// sigma under 2 % (measured: 0.4-0.5 %, the images' 8-bit rounding; it was 12-24 % while
-/// the pixels clipped in any channel were left out, and the water's correlation grew the
-/// image's share too), and the error within 3 of it.
-fn assert_pair(scene: &Scene, lit: &Lit) {
+/// Every truth light of harbour layout `layout` has one fitted light whose edges are within
+/// 3 % of its size; no other light. A light whose image shows some channel unclipped (the
+/// pair's, the three lights') has its radiance read off the image: within 3 % per channel,
+/// every channel's sigma under 2 % (measured: 0.3-0.5 %, the images' 8-bit rounding; it was
+/// 12-24 % while the pixels clipped in any channel were left out, and the water's correlation
+/// grew the image's share too), and the error within 3 of it. A light its image clips in
+/// every channel (the warm white sign) has only the reflections to give its radiance, and one
+/// realisation of the waves gives it no better than that realisation holds the expected
+/// light (the sign's photo holds 5.4 % less than its expectation:
+/// `tests/water_model.rs`, `the_signs_photo_holds_less_light_than_its_expectation`): held
+/// within 3 of its sigma, the sigma under 6 % so that it cannot claim less than that
+/// shortfall without being right (measured: 3.0-3.6 % low at sigma 4.8 %, fit seeds 1-3).
+fn assert_layout(layout: &str, scene: &Scene, lit: &Lit) {
     let layouts = harbour::layouts();
-    let truths = &layouts.iter().find(|l| l.0 == "pair").unwrap().2;
+    let truths = &layouts.iter().find(|l| l.0 == layout).unwrap().2;
     assert_eq!(lit.lights.len(), truths.len(), "{:?}", lit.lights);
     let bounds = |l: &FittedLight| {
         let a = l.world_at(scene.origin, l.u_min, l.v_min);
         let b = l.world_at(scene.origin, l.u_max, l.v_max);
         [a.x.min(b.x), a.x.max(b.x), a.y.min(b.y), a.y.max(b.y)]
     };
+    let mut matched = Vec::new();
     for t in truths {
         let want = [
             t.corner.x,
@@ -50,6 +59,8 @@ fn assert_pair(scene: &Scene, lit: &Lit) {
         let k = (0..lit.lights.len())
             .min_by(|&a, &b| d(&lit.lights[a]).total_cmp(&d(&lit.lights[b])))
             .unwrap();
+        assert!(!matched.contains(&k), "{}: light {k} matched twice", t.name);
+        matched.push(k);
         let (fitted, sigma) = (&lit.lights[k], &lit.uncertainties[k]);
         let got = bounds(fitted);
         for (k, name) in ["left", "right", "bottom", "top"].iter().enumerate() {
@@ -64,10 +75,15 @@ fn assert_pair(scene: &Scene, lit: &Lit) {
                 100.0 * error
             );
         }
+        let (bar, sigma_bar) = if sigma.radiance_seen {
+            (Some(0.03), 0.02)
+        } else {
+            (None, 0.06)
+        };
         for c in 0..3 {
             let error = fitted.radiance[c] as f64 / t.radiance[c] - 1.0;
             assert!(
-                error.abs() < 0.03,
+                bar.is_none_or(|bar| error.abs() < bar),
                 "{}: radiance {:?} against {:?}",
                 t.name,
                 fitted.radiance,
@@ -76,15 +92,43 @@ fn assert_pair(scene: &Scene, lit: &Lit) {
             let sd = sigma.radiance[c] as f64;
             let off = fitted.radiance[c] as f64 - t.radiance[c];
             assert!(
-                sd < 0.02 * t.radiance[c] && off.abs() < 3.0 * sd,
-                "{}: radiance {:?} against {:?}, sigma {:?}",
+                sd < sigma_bar * t.radiance[c] && off.abs() < 3.0 * sd,
+                "{}: radiance {:?} against {:?}, sigma {:?} (seen: {})",
                 t.name,
                 fitted.radiance,
                 t.radiance,
-                sigma.radiance
+                sigma.radiance,
+                sigma.radiance_seen
             );
         }
     }
+}
+
+/// [`assert_layout`] of the pair.
+fn assert_pair(scene: &Scene, lit: &Lit) {
+    assert_layout("pair", scene, lit);
+}
+
+/// `fit` at the defaults of harbour layout `layout`'s photo with its lamps in frame against
+/// sample scene `scene`: the statistical model, chosen by the photo, and the lights as
+/// [`assert_layout`] holds them.
+fn statistical_in_frame(scene: &str, layout: &str) {
+    let fitting = sample_scene(scene, None);
+    let photo = sample_photo(&format!("harbour-{layout}.png"));
+    let lit = pipeline::fit(
+        &fitting,
+        &photo,
+        &FitSettings::default(),
+        Reporter::default(),
+    )
+    .unwrap();
+    let used = &lit.water_model;
+    assert_eq!(
+        (used.model, used.chosen),
+        ("statistical", "detected"),
+        "{used:?}"
+    );
+    assert_layout(layout, &fitting, &lit);
 }
 
 #[test]
@@ -233,4 +277,31 @@ fn known_slope_variances_are_recovered_from_an_isotropic_start() {
         );
     }
     assert_pair(&scene, &lit);
+}
+
+/// The pair over the flat quad a game scene holds (`harbour-flat.gltf`): no waves to match,
+/// so the statistical model, and the lights within 3 % (measured: edges within 0.07 %,
+/// radiances within 0.6 %).
+#[test]
+fn the_pair_over_a_flat_quad() {
+    statistical_in_frame("harbour-flat.gltf", "pair");
+}
+
+/// The three lights of different sizes and colours in frame over another wave field and over
+/// the flat quad: each within 3 % (measured: edges within 0.13 %, radiances within 0.7 %).
+#[test]
+fn three_lights_over_other_waves_and_a_flat_quad() {
+    for scene in ["harbour-other-waves.gltf", "harbour-flat.gltf"] {
+        statistical_in_frame(scene, "three");
+    }
+}
+
+/// The warm white sign in frame over another wave field and over the flat quad: its image
+/// clips every channel, so its edges come from the image (within 3 %; measured 0.5 %) and its
+/// radiance from the reflections alone, within its sigma ([`assert_layout`]).
+#[test]
+fn the_sign_over_other_waves_and_a_flat_quad() {
+    for scene in ["harbour-other-waves.gltf", "harbour-flat.gltf"] {
+        statistical_in_frame(scene, "sign");
+    }
 }
