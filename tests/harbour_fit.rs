@@ -31,8 +31,8 @@ use streaklight::water_model::water_statistics;
 /// realisation of the waves gives it no better than that realisation holds the expected
 /// light (the sign's photo holds 5.4 % less than its expectation:
 /// `tests/water_model.rs`, `the_signs_photo_holds_less_light_than_its_expectation`): held
-/// within 3 of its sigma, the sigma under 6 % so that it cannot claim less than that
-/// shortfall without being right (measured: 3.0-3.6 % low at sigma 4.8 %, fit seeds 1-3).
+/// within 3 of its sigma (a sigma too small for that shortfall fails there) and the sigma
+/// under 6 % (measured: 2.9-3.7 % low at sigma 4.8 %, fit seeds 1-3).
 fn assert_layout(layout: &str, scene: &Scene, lit: &Lit) {
     let layouts = harbour::layouts();
     let truths = &layouts.iter().find(|l| l.0 == layout).unwrap().2;
@@ -297,7 +297,7 @@ fn three_lights_over_other_waves_and_a_flat_quad() {
 }
 
 /// The warm white sign in frame over another wave field and over the flat quad: its image
-/// clips every channel, so its edges come from the image (within 3 %; measured 0.5 %) and its
+/// clips every channel, so its edges come from the image (within 3 %; measured 0.4-0.6 %) and its
 /// radiance from the reflections alone, within its sigma ([`assert_layout`]).
 #[test]
 fn the_sign_over_other_waves_and_a_flat_quad() {
