@@ -13,6 +13,11 @@
 //! memory grow with the photo (600 x 600, 1920 x 1080, 4000 x 3000) and with the water mesh
 //! (0.5 M, 2 M, 8 M triangles).
 //!
+//! `cargo bench --bench speed -- --water-models` fits the harbour photos (three layouts, their
+//! lamps in frame) against the scene of the photo's own waves (the exact model), another
+//! realisation of them and the flat quad (the statistical model), and the pair rendered at
+//! 1920 x 1080 likewise, and prints each fit's time and memory against the exact fit's.
+//!
 //! Mitsuba is looked for in `$STREAKLIGHT_MITSUBA_PYTHON`, in the venv `target/mitsuba-venv`
 //! and in `python3`; when none has it, the bench installs it there (`pip install mitsuba
 //! numpy`, and Debian's `libllvm19` when no libLLVM 16 or newer is found, which the LLVM
@@ -26,6 +31,7 @@
 
 mod child;
 mod mitsuba;
+mod water_models;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -43,6 +49,8 @@ struct FitRun {
     measured: Measured,
     stages: Vec<(String, f64)>,
     lights: usize,
+    /// The water model the fit used (the report's `water_model.model`).
+    model: String,
 }
 
 /// The best of `runs` `streaklight fit SCENE PHOTO --exposure 0.1 EXTRA` as child processes.
@@ -78,6 +86,10 @@ fn fit(scene: &Path, photo: &Path, extra: &[&str], runs: usize, dir: &Path) -> F
             })
             .unwrap_or_default();
         let lights = json["lights"].as_array().map_or(0, Vec::len);
+        let model = json["water_model"]["model"]
+            .as_str()
+            .unwrap_or("?")
+            .to_owned();
         if best
             .as_ref()
             .is_none_or(|b| measured.wall < b.measured.wall)
@@ -86,6 +98,7 @@ fn fit(scene: &Path, photo: &Path, extra: &[&str], runs: usize, dir: &Path) -> F
                 measured,
                 stages,
                 lights,
+                model,
             });
         }
     }
@@ -120,25 +133,31 @@ fn render_photo(scene: &Path, photo: &Path, (width, height): (u32, u32), dir: &P
 
 /// `scene.gltf` and `table1-truth.gltf` in `dir` for a `width` x `height` photo: copies whose
 /// camera has the photo's aspect ratio (the same vertical field of view) when it is not square.
-fn scenes_for(dir: &Path, (width, height): (u32, u32)) -> (PathBuf, PathBuf) {
+fn scenes_for(dir: &Path, size: (u32, u32)) -> (PathBuf, PathBuf) {
+    (
+        aspect_copy(dir, "scene", size),
+        aspect_copy(dir, "table1-truth", size),
+    )
+}
+
+/// `NAME.gltf` in `dir` for a `width` x `height` photo: the file itself when the photo is
+/// square, otherwise a copy beside it whose cameras have the photo's aspect ratio (the same
+/// vertical field of view).
+fn aspect_copy(dir: &Path, name: &str, (width, height): (u32, u32)) -> PathBuf {
+    let from = dir.join(format!("{name}.gltf"));
     if width == height {
-        return (dir.join("scene.gltf"), dir.join("table1-truth.gltf"));
+        return from;
     }
-    let copy = |name: &str| {
-        let from = dir.join(format!("{name}.gltf"));
-        let to = dir.join(format!("{name}-{width}x{height}.gltf"));
-        let text = std::fs::read_to_string(&from).unwrap_or_else(|e| panic!("{e}"));
-        let mut doc: serde_json::Value =
-            serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"));
-        if let Some(cameras) = doc["cameras"].as_array_mut() {
-            for camera in cameras {
-                camera["perspective"]["aspectRatio"] = (width as f64 / height as f64).into();
-            }
+    let to = dir.join(format!("{name}-{width}x{height}.gltf"));
+    let text = std::fs::read_to_string(&from).unwrap_or_else(|e| panic!("{e}"));
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"));
+    if let Some(cameras) = doc["cameras"].as_array_mut() {
+        for camera in cameras {
+            camera["perspective"]["aspectRatio"] = (width as f64 / height as f64).into();
         }
-        std::fs::write(&to, doc.to_string()).unwrap_or_else(|e| panic!("{e}"));
-        to
-    };
-    (copy("scene"), copy("table1-truth"))
+    }
+    std::fs::write(&to, doc.to_string()).unwrap_or_else(|e| panic!("{e}"));
+    to
 }
 
 fn load_text(m: &Measured) -> String {
@@ -171,6 +190,8 @@ fn main() {
     println!("load average at start: {:.2}", load_average());
     if cost {
         cost_table(&dir);
+    } else if std::env::args().any(|a| a == "--water-models") {
+        water_models::water_models(&dir, runs("SPEED_RUNS", 3));
     } else {
         speed(&dir, runs("SPEED_RUNS", 3), runs("SPEED_LONG_RUNS", 1));
     }
