@@ -7,7 +7,7 @@
 //! rectangle: the edge profiles ([`super::profile`]) and the state's updates
 //! ([`super::problem`]) read them alone, and take the rest from the coefficient as it is.
 
-use super::kernel::kernel_coverage;
+use super::kernel::{kernel_coverage, POINT_CELL};
 use super::samples::PlaneSamples;
 use crate::fitting::rect::Rect;
 
@@ -22,10 +22,19 @@ impl PlaneSamples {
         along_u: bool,
         from: &Rect,
         to: &Rect,
+        band: (f32, f32),
     ) -> [(f64, f64); 2] {
         let mut sums = [(0f64, 0f64); 2];
         for q in ids {
             let (p, h) = (self.points[q], self.cells[q]);
+            // A sample whose kernel lies wholly outside the band the edge sweeps has the
+            // same share of both rectangles: it adds nothing to their difference, the one
+            // thing the sums are read for.
+            let (x, hx) = if along_u { (p.x, h.x) } else { (p.y, h.y) };
+            let reach = hx.abs().max(POINT_CELL);
+            if x + reach < band.0 || x - reach > band.1 {
+                continue;
+            }
             // Each product in the order `coefficient` takes it (u, then v).
             let f = if along_u {
                 let v = kernel_coverage(p.y, h.y, from.v_min, from.v_max);
@@ -90,8 +99,9 @@ impl PlaneSamples {
             let (c1, d1) = self.coefficient(i, to, inv_samples);
             return (c1 as f64 - c0 as f64, d1 as f64 - d0 as f64);
         };
-        let near = self.near(i, along_u, a.min(b), a.max(b));
-        let [(s0, d0), (s1, d1)] = self.sums_inside_both(near, along_u, from, to);
+        let band = (a.min(b), a.max(b));
+        let near = self.near(i, along_u, band.0, band.1);
+        let [(s0, d0), (s1, d1)] = self.sums_inside_both(near, along_u, from, to, band);
         let g = &self.gauss[i];
         let inv = inv_samples as f64;
         (
