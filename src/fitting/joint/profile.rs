@@ -389,8 +389,8 @@ mod tests {
     #[test]
     fn an_edge_profile_is_the_cost_and_radiance_at_every_grid_point() {
         // Table 3's light0 samples, a photo its true rectangle gives, and a start 0.3 m off
-        // on every side. At every grid point of every edge, over a wide window and a narrow
-        // one, the profile (which reads only the samples near the window) must give the
+        // on every side. At every grid point of every edge, over a wide window and two narrow
+        // ones, the profile (which reads only the samples near the window) must give the
         // radiance the normal equation of the whole coefficients gives there, and the cost
         // differences the whole cost gives. Then again with the brightest pixels clipped in
         // their first channel (the radiance is then solved without them, and they count only
@@ -426,7 +426,13 @@ mod tests {
         let grid = 17;
         for side in EdgeSide::ALL {
             let cur = start.edge(side);
-            for (lo, step) in [(cur - 0.5, 1.0 / 16.0), (cur - 0.004, 0.0005)] {
+            // A wide window, a narrow one, and a narrow one wholly beside the edge's place
+            // now (the band the profile reads then spans both).
+            for (lo, step) in [
+                (cur - 0.5, 1.0 / 16.0),
+                (cur - 0.004, 0.0005),
+                (cur + 0.05, 0.0005),
+            ] {
                 let profile = problem.edge_profile(&st, 0, side, lo, step, grid);
                 let mut costs = Vec::new();
                 for (j, (_, l)) in profile.iter().enumerate() {
