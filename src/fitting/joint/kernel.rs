@@ -147,6 +147,15 @@ pub(super) fn kernel_coverage(x: f32, h: f32, lo: f32, hi: f32) -> f32 {
 /// every purpose, but with a slope the ramps can hold.
 pub(super) const POINT_CELL: f32 = 1e-6;
 
+/// Whether the kernel of a sample at `x` with half-width `h` ([`kernel_coverage`]) lies
+/// wholly below `lo` or wholly above `hi`: an edge moving between them leaves its share of
+/// the rectangle as it is.
+#[inline]
+pub(super) fn kernel_outside(x: f32, h: f32, lo: f64, hi: f64) -> bool {
+    let reach = h.abs().max(POINT_CELL);
+    ((x + reach) as f64) < lo || ((x - reach) as f64) > hi
+}
+
 /// The smallest width and height of a light whose samples' kernels have the half-widths
 /// `cells`: twice the median half-width along each axis, the kernels' typical full width (at
 /// least [`SMALLEST_LIGHT_SHARE`] of the plane's `distance` from the camera, when the cells

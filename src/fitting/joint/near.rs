@@ -7,7 +7,7 @@
 //! rectangle: the edge profiles ([`super::profile`]) and the state's updates
 //! ([`super::problem`]) read them alone, and take the rest from the coefficient as it is.
 
-use super::kernel::{kernel_coverage, POINT_CELL};
+use super::kernel::{kernel_coverage, kernel_outside};
 use super::samples::PlaneSamples;
 use crate::fitting::rect::Rect;
 
@@ -31,8 +31,7 @@ impl PlaneSamples {
             // same share of both rectangles: it adds nothing to their difference, the one
             // thing the sums are read for.
             let (x, hx) = if along_u { (p.x, h.x) } else { (p.y, h.y) };
-            let reach = hx.abs().max(POINT_CELL);
-            if x + reach < band.0 || x - reach > band.1 {
+            if kernel_outside(x, hx, band.0 as f64, band.1 as f64) {
                 continue;
             }
             // Each product in the order `coefficient` takes it (u, then v).

@@ -7,7 +7,7 @@
 //! ([`EdgeRamps`]); [`PlaneSamples::edge_coefficients`] adds the control variate's exact mass
 //! at each grid point.
 
-use super::kernel::{kernel_coverage, POINT_CELL};
+use super::kernel::{kernel_coverage, kernel_outside, POINT_CELL};
 use super::near::Near;
 use super::samples::PlaneSamples;
 use crate::fitting::rect::Rect;
@@ -114,11 +114,8 @@ impl PlaneSamples {
             } else {
                 (p.y, h.y, p.x, h.x)
             };
-            if let Some((lo, hi)) = band {
-                let reach = hx.abs().max(POINT_CELL);
-                if ((x + reach) as f64) < lo || ((x - reach) as f64) > hi {
-                    continue;
-                }
+            if band.is_some_and(|(lo, hi)| kernel_outside(x, hx, lo, hi)) {
+                continue;
             }
             let (w, half) = (self.weights[q], self.halves[q]);
             let across = kernel_coverage(y, hy, frame.across.0, frame.across.1);
