@@ -7,7 +7,10 @@
 //! scene, each as a child process (`streaklight fit`, wall time and peak resident memory),
 //! renders the Table 1 scene with Mitsuba at both sizes (mitsuba_render.py beside this file,
 //! 64 spp, path depth 3, in a fresh process each time) and prints every figure, its ratio to
-//! Mitsuba's read + load + render, and the load average around it.
+//! Mitsuba's whole process (spawn to exit: what a user waits for, and how the fits are timed;
+//! the targets are judged on it), its ratio to Mitsuba's read + load + render timed inside
+//! the process (stricter: no interpreter start, imports or exit), and the load average
+//! around it.
 //!
 //! `cargo bench --bench speed -- --cost` instead measures how the default fit's time and
 //! memory grow with the photo (600 x 600, 1920 x 1080, 4000 x 3000) and with the water mesh
@@ -278,19 +281,19 @@ fn speed(dir: &Path, runs: usize, long_runs: usize) {
             mitsuba::SPP,
             mitsuba::DEPTH
         );
-        println!("| size | import | read glTF | load_dict (BVH) | render | read + load + render | process wall | peak MiB | load avg |");
+        println!("| size | import | read glTF | load_dict (BVH) | render | read + load + render | process wall (the anchor) | peak MiB | load avg |");
         println!("|---|---|---|---|---|---|---|---|---|");
     }
     for (a, size) in anchors.iter().zip(["600 x 600", "1920 x 1080"]) {
         if let Some(a) = a {
             println!(
-                "| {size} | {:.2} | {:.2} | {:.2} | {:.2} | **{:.2}** | {:.2} | {:.0} | {} |",
+                "| {size} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | **{:.2}** | {:.0} | {} |",
                 a.import,
                 a.read,
                 a.load,
                 a.render,
+                a.in_process(),
                 a.anchor(),
-                a.process.wall,
                 a.process.peak_mib,
                 load_text(&a.process)
             );
@@ -346,8 +349,11 @@ fn speed(dir: &Path, runs: usize, long_runs: usize) {
         ),
     ];
     println!("\nstreaklight fit, child processes (best of the runs):\n");
-    println!("| fit | runs | lights | wall s | peak MiB | load avg | / Mitsuba | target |");
-    println!("|---|---|---|---|---|---|---|---|");
+    println!(
+        "| fit | runs | lights | wall s | peak MiB | load avg | / Mitsuba's process | \
+         / its read + load + render | target (on the process) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
     let mut stages = Vec::new();
     for Case {
         name,
@@ -363,13 +369,17 @@ fn speed(dir: &Path, runs: usize, long_runs: usize) {
         let ratio = anchors[anchor]
             .as_ref()
             .map(|a| f.measured.wall / a.anchor());
+        let strict = anchors[anchor]
+            .as_ref()
+            .map(|a| f.measured.wall / a.in_process());
         println!(
-            "| {name} | {runs} | {} | {:.2} | {:.0} | {} | {} | {} |",
+            "| {name} | {runs} | {} | {:.2} | {:.0} | {} | {} | {} | {} |",
             f.lights,
             f.measured.wall,
             f.measured.peak_mib,
             load_text(&f.measured),
             ratio.map_or("-".into(), |r| format!("**{r:.2}**")),
+            strict.map_or("-".into(), |r| format!("{r:.2}")),
             match ratio {
                 Some(r) if r <= target => format!("<= {target}: met"),
                 Some(_) => format!("<= {target}: not met"),

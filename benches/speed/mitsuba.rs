@@ -177,11 +177,22 @@ pub struct MitsubaRun {
     pub load: f64,
     pub render: f64,
     pub process: Measured,
+    /// The shortest process wall time of the runs (the run kept is the one of the shortest
+    /// [`Self::in_process`], which need not be it).
+    pub best_wall: f64,
 }
 
 impl MitsubaRun {
-    /// What the fit is compared with: reading the scene, building it, rendering it.
+    /// What a user waits for: the fresh process that imports Mitsuba, reads the scene, builds
+    /// it and renders it, from spawn to exit (the fits are timed the same way). This is the
+    /// anchor the targets are judged against.
     pub fn anchor(&self) -> f64 {
+        self.best_wall
+    }
+
+    /// The stricter figure: reading the scene, building it and rendering it, timed inside
+    /// the process (without the interpreter's start, the imports and the exit).
+    pub fn in_process(&self) -> f64 {
         self.read + self.load + self.render
     }
 }
@@ -197,7 +208,8 @@ pub fn render(
 ) -> Result<MitsubaRun, String> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/speed/mitsuba_render.py");
     let mut best: Option<MitsubaRun> = None;
-    for _ in 0..=runs {
+    let mut best_wall = f64::INFINITY;
+    for run_index in 0..=runs {
         let mut cmd = Command::new(&m.python);
         cmd.arg(&script)
             .arg(scene)
@@ -216,16 +228,26 @@ pub fn render(
         let json: serde_json::Value = serde_json::from_str(process.stdout.trim())
             .map_err(|e| format!("mitsuba_render.py printed no JSON ({e})"))?;
         let seconds = |k: &str| json.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+        // The first run is the warm-up: it fills Dr.Jit's kernel cache.
+        if run_index == 0 {
+            continue;
+        }
+        best_wall = best_wall.min(process.wall);
         let this = MitsubaRun {
             import: seconds("import_s"),
             read: seconds("read_s"),
             load: seconds("load_s"),
             render: seconds("render_s"),
             process,
+            best_wall: f64::NAN,
         };
-        if best.as_ref().is_none_or(|b| this.anchor() < b.anchor()) {
+        if best
+            .as_ref()
+            .is_none_or(|b| this.in_process() < b.in_process())
+        {
             best = Some(this);
         }
     }
-    best.ok_or_else(|| "no run".into())
+    best.map(|b| MitsubaRun { best_wall, ..b })
+        .ok_or_else(|| "no run".into())
 }

@@ -254,33 +254,28 @@ pub fn fit_joint_with(
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model
     };
-    let mut pixels = region(
-        options.region_water.unwrap_or(water_model),
-        scene,
-        &probe_model,
-        &planes,
-        &roi,
-        photo,
-        water,
-        &used,
-        options.margin,
-        options.pixels,
-    );
+    let region_read = |share| {
+        region(
+            options.region_water.unwrap_or(water_model),
+            scene,
+            &probe_model,
+            &planes,
+            &roi,
+            photo,
+            water,
+            &used,
+            options.margin,
+            share,
+        )
+    };
     // Where every lamp pins its light and the water is plenty, one water pixel of each 2 x 2
-    // block (`JointOptions::thin_seen_whole`): those of the checkerboard's in even rows.
-    let mut share = options.pixels;
+    // block (`JointOptions::thin_seen_whole`): those of the checkerboard's in even rows. Its
+    // region is the checkerboard's region's pixels it reads, so it is probed alone first.
     let thinned = options.share_for(images.iter().all(Option::is_some));
-    if thinned != share {
-        let kept: Vec<u32> = pixels
-            .iter()
-            .copied()
-            .filter(|&p| thinned.reads(p % photo.width, p / photo.width))
-            .collect();
-        if kept.len() >= THIN_MIN_WATER_PIXELS {
-            pixels = kept;
-            share = thinned;
-        }
-    }
+    let (mut pixels, share) = match (thinned != options.pixels).then(|| region_read(thinned)) {
+        Some(kept) if kept.len() >= THIN_MIN_WATER_PIXELS => (kept, thinned),
+        _ => (region_read(options.pixels), options.pixels),
+    };
     // The pixels that see the lights' walls directly follow the water pixels.
     let first_direct = pixels.len();
     if options.direct_view {
