@@ -529,3 +529,42 @@ fn the_signs_photo_holds_less_light_than_its_expectation() {
     assert!((own - 1.0).abs() < 0.015, "{own}");
     assert!((0.92..0.97).contains(&waves), "{waves}");
 }
+
+/// The quick test ahead of the exact fit (`water_model::clearly_wavy`): a quarter of the
+/// statistics' camera rays and the seen normals' own mean as the plane. On both sample wave
+/// meshes its slope variances lie within 15 % of [`water_statistics`]'s on each axis
+/// (measured when this was written: within 5 %), so a mesh it calls clearly wavy (three
+/// times the flatness threshold) is not flat by the full statistics; on a flat quad it never
+/// calls the water wavy, whatever the threshold.
+#[test]
+fn a_clearly_wavy_mesh_is_told_by_a_quarter_of_the_rays() {
+    use streaklight::water_model::clearly_wavy;
+    let (w, h) = (600, 600);
+    for name in ["scene.gltf", "harbour.gltf"] {
+        let scene = sample_scene(name, None);
+        let full = water_statistics(&scene, w, h).unwrap().slope_variance;
+        for axis in 0..2 {
+            // Over `factor` times the full variance on `axis` alone.
+            let over = |factor: f32| {
+                let mut threshold = [f32::INFINITY; 2];
+                threshold[axis] = factor * full[axis] / 3.0;
+                clearly_wavy(&scene, w, h, threshold)
+            };
+            assert!(
+                over(0.85),
+                "{name}, axis {axis}: under 0.85 of {:e}",
+                full[axis]
+            );
+            assert!(
+                !over(1.15),
+                "{name}, axis {axis}: over 1.15 of {:e}",
+                full[axis]
+            );
+        }
+        let flat = flattened(scene);
+        assert!(
+            !clearly_wavy(&flat, w, h, [1e-12, 1e-12]),
+            "{name} flattened"
+        );
+    }
+}

@@ -13,7 +13,7 @@ use crate::fitting::slopes::{estimate_slopes, water_with_total, MICROFACET_GLOSS
 use crate::fitting::{self, FitOptions};
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::settings::Setting;
-use crate::water_model::{water_statistics, WaterStatistics};
+use crate::water_model::{clearly_wavy, water_statistics, WaterStatistics};
 use crate::{Error, Result};
 
 impl WaterModelUsed {
@@ -156,9 +156,14 @@ impl Run<'_> {
     }
 
     fn flat_water(&self) -> Option<String> {
-        let stats = self.water_statistics()?;
         let gloss = self.paper.model.gloss;
         let micro = GaussianSlopes::from_gloss(gloss).variance;
+        // A mesh clearly wavy is told by a quarter of the rays, before the full statistics.
+        let threshold = micro.map(|v| FLAT_SHARE * v);
+        if clearly_wavy(self.scene, self.photo.width, self.photo.height, threshold) {
+            return None;
+        }
+        let stats = self.water_statistics()?;
         let mesh = stats.slope_variance;
         (mesh[0] < FLAT_SHARE * micro[0] && mesh[1] < FLAT_SHARE * micro[1]).then(|| {
             format!(

@@ -41,7 +41,7 @@ use glam::{Vec2, Vec3};
 
 pub use draws::LobeDraws;
 pub use exact::ExactSurface;
-pub use mean_surface::{water_statistics, MeanSurface, WaterStatistics};
+pub use mean_surface::{clearly_wavy, water_statistics, MeanSurface, WaterStatistics};
 pub use statistical::{StatisticalSurface, ViewedLobe};
 
 use crate::optics::{LobeSample, ReflectionModel};
