@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 pub use area_lights::AreaLight;
 pub use camera::Camera;
@@ -293,7 +294,7 @@ pub fn load_from_bytes(
     let tracer = Tracer::new(
         &tris
             .positions
-            .iter()
+            .par_iter()
             .map(|&vertices| Triangle { vertices })
             .collect::<Vec<_>>(),
     );

@@ -152,10 +152,23 @@ pub(super) fn tiles(triangles: &[Triangle], per_tile: usize) -> Vec<Tile> {
         centre: ((t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0).to_array(),
         index: k as u32,
     };
+    // On every core only outside rayon's workers: a tracer may be built lazily inside a
+    // parallel loop (`Scene::closest_hit_above_water`), where a worker waiting for a half
+    // could take up a task of that loop which asks for this very tracer, and wait on
+    // itself. Either way the same tiles, in the same order.
+    let parallel = rayon::current_thread_index().is_none();
     // The ordinary triangles first, the large ones after them, in tiles of their own; many
     // large ones (a city's facades) are cut into tiles among themselves.
-    let is_large: Vec<bool> = triangles.iter().map(|t| size(t) > large).collect();
-    let mut items: Vec<Item> = triangles.iter().enumerate().map(item).collect();
+    let (is_large, mut items): (Vec<bool>, Vec<Item>) = if parallel {
+        let is_large = triangles.par_iter().map(|t| size(t) > large).collect();
+        (
+            is_large,
+            triangles.par_iter().enumerate().map(item).collect(),
+        )
+    } else {
+        let is_large = triangles.iter().map(|t| size(t) > large).collect();
+        (is_large, triangles.iter().enumerate().map(item).collect())
+    };
     let mut ordinary = n;
     let mut k = 0;
     while k < ordinary {
@@ -166,11 +179,6 @@ pub(super) fn tiles(triangles: &[Triangle], per_tile: usize) -> Vec<Tile> {
             k += 1;
         }
     }
-    // On every core only outside rayon's workers: a tracer may be built lazily inside a
-    // parallel loop (`Scene::closest_hit_above_water`), where a worker waiting for a half
-    // could take up a task of that loop which asks for this very tracer, and wait on
-    // itself. Either way the same tiles, in the same order.
-    let parallel = rayon::current_thread_index().is_none();
     let (first, rest) = items.split_at_mut(ordinary);
     let mut ranges = Vec::new();
     split(first, 0, per_tile, parallel, &mut ranges);
