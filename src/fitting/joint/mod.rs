@@ -150,7 +150,7 @@ use direct_start::enclosing_image;
 pub use lamp_starts::place_starts;
 use optimise::{optimise, start_state};
 use problem::{Problem, State};
-use region::{region, region_of_interest};
+use region::{region, region_of_interest, KeptRegion, RegionKey};
 use repeats::mean_and_spread;
 use samples::sample_extent;
 use uncertainty::uncertainties;
@@ -254,9 +254,10 @@ pub fn fit_joint_with(
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model
     };
+    let region_water = options.region_water.unwrap_or(water_model);
     let region_read = |share| {
         region(
-            options.region_water.unwrap_or(water_model),
+            region_water,
             scene,
             &probe_model,
             &planes,
@@ -272,23 +273,53 @@ pub fn fit_joint_with(
     // block (`JointOptions::thin_seen_whole`): those of the checkerboard's in even rows. Its
     // region is the checkerboard's region's pixels it reads, so it is probed alone first.
     let thinned = options.share_for(images.iter().all(Option::is_some));
-    let (mut pixels, share) = match (thinned != options.pixels).then(|| region_read(thinned)) {
-        Some(kept) if kept.len() >= THIN_MIN_WATER_PIXELS => (kept, thinned),
-        _ => (region_read(options.pixels), options.pixels),
+    let key = RegionKey::new(
+        region_water,
+        &probe_model,
+        &planes,
+        &roi,
+        &used,
+        options.margin,
+        (options.pixels, thinned),
+        options.direct_view,
+    );
+    // A search's later fit reads the pixels of its first where they were made alike.
+    let kept = options
+        .reweight
+        .and_then(|rw| rw.cache.region.get())
+        .filter(|k| k.key == key);
+    let (pixels, share, first_direct) = match kept {
+        Some(k) => (k.pixels.clone(), k.share, k.first_direct),
+        None => {
+            let (mut pixels, share) =
+                match (thinned != options.pixels).then(|| region_read(thinned)) {
+                    Some(kept) if kept.len() >= THIN_MIN_WATER_PIXELS => (kept, thinned),
+                    _ => (region_read(options.pixels), options.pixels),
+                };
+            // The pixels that see the lights' walls directly follow the water pixels.
+            let first_direct = pixels.len();
+            if options.direct_view {
+                pixels.extend(direct_pixels(
+                    scene,
+                    &planes,
+                    &roi,
+                    photo.width,
+                    photo.height,
+                    water,
+                    share,
+                ));
+            }
+            if let Some(rw) = options.reweight {
+                let _ = rw.cache.region.set(KeptRegion {
+                    key,
+                    pixels: pixels.clone(),
+                    first_direct,
+                    share,
+                });
+            }
+            (pixels, share, first_direct)
+        }
     };
-    // The pixels that see the lights' walls directly follow the water pixels.
-    let first_direct = pixels.len();
-    if options.direct_view {
-        pixels.extend(direct_pixels(
-            scene,
-            &planes,
-            &roi,
-            photo.width,
-            photo.height,
-            water,
-            share,
-        ));
-    }
     let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
         let fit = proposal::FitSamples {
             water_model,

@@ -5,6 +5,7 @@ use std::sync::OnceLock;
 
 use glam::Vec3;
 
+use super::region::KeptRegion;
 use super::reweight::{reweighted, Recorded};
 use super::samples::PlaneSamples;
 use crate::fitting::light_plane::LightPlane;
@@ -109,6 +110,9 @@ pub struct ProposalCache {
     /// The proposal: on each axis at least as broad as every target it serves.
     pub proposal: Lobe,
     pub(super) traced: OnceLock<ProposalTrace>,
+    /// The pixels of the search's first fit, which its later fits read again where their
+    /// region's key is the same.
+    pub(super) region: OnceLock<KeptRegion>,
 }
 
 /// The recorded trace, with what it was traced for: a fit whose pixels, planes or regions
@@ -128,6 +132,7 @@ impl ProposalCache {
         ProposalCache {
             proposal,
             traced: OnceLock::new(),
+            region: OnceLock::new(),
         }
     }
 

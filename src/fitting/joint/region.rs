@@ -188,6 +188,62 @@ fn sees_region_of_interest(
     })
 }
 
+/// What a joint fit's pixels depend on beyond the scene and the photo. A search's fits over
+/// one start agree on all of it, so the first one's pixels serve the rest
+/// ([`KeptRegion`], held by [`super::proposal::ProposalCache`]): probing the region and
+/// listing the pixels that see the walls took 12-20 ms a fit over the harbour pair, eight
+/// or nine fits a slope search.
+#[derive(Debug, PartialEq)]
+pub(super) struct RegionKey {
+    /// The probe's water model and reflection model as their debug text: every field, each
+    /// number to its last digit.
+    models: String,
+    planes: Vec<LightPlane>,
+    roi: Vec<Rect>,
+    /// The streaks the lights start from (their pixels seed the region).
+    streaks: Vec<usize>,
+    margin: u32,
+    /// The share of the water pixels asked for, and the one a fit thinned where every lamp
+    /// pins its light would read.
+    asked: PixelShare,
+    thinned: PixelShare,
+    direct_view: bool,
+}
+
+impl RegionKey {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn new(
+        probe_water: &dyn WaterModel,
+        probe_model: &ReflectionModel,
+        planes: &[&LightPlane],
+        roi: &[Rect],
+        streaks: &[&StreakObservation],
+        margin: u32,
+        (asked, thinned): (PixelShare, PixelShare),
+        direct_view: bool,
+    ) -> Self {
+        RegionKey {
+            models: format!("{probe_water:?} {probe_model:?}"),
+            planes: planes.iter().map(|p| (*p).clone()).collect(),
+            roi: roi.to_vec(),
+            streaks: streaks.iter().map(|s| s.id).collect(),
+            margin,
+            asked,
+            thinned,
+            direct_view,
+        }
+    }
+}
+
+/// A fit's pixels as its region made them: the water pixels, then from `first_direct` on
+/// those that see a light's wall directly, the water read at `share`.
+pub(super) struct KeptRegion {
+    pub(super) key: RegionKey,
+    pub(super) pixels: Vec<u32>,
+    pub(super) first_direct: usize,
+    pub(super) share: PixelShare,
+}
+
 /// Where on its plane a light's edges may go during the fit: samples landing outside it are
 /// never traced.
 ///
@@ -269,6 +325,39 @@ mod tests {
             region_of_interest(&light, Some((image, 0.5))),
             start.grow(1.875),
         );
+    }
+
+    /// A search's later fit reads its first fit's pixels only where everything they were made
+    /// from is the same: the probe's water model to its last digit (a statistical surface of
+    /// other slope variances, or the exact model), its gloss, the planes, the regions of
+    /// interest, the margin and the shares.
+    #[test]
+    fn a_kept_region_serves_only_a_fit_made_alike() {
+        use crate::fitting::slopes::water_with_total;
+        use crate::water_model::{ExactSurface, MeanSurface};
+        let plane =
+            LightPlane::with_frame((0, 0, 0), Vec3::new(0.0, 0.0, -10.0), Vec3::Z, Vec3::X, 1.0)
+                .expect("a plane");
+        let surface = MeanSurface::new(Vec3::new(0.0, -1.0, 0.0), Vec3::Y, Vec3::Z, Vec3::Y);
+        let broad = water_with_total(surface, [4e-3, 3e-3]);
+        let model = ReflectionModel::new(500.0, 1.33);
+        let roi = [rect(0.0, 3.0, 0.0, 2.0)];
+        let shares = (PixelShare::Checkerboard, PixelShare::Quarter);
+        let key = |water: &dyn WaterModel, model: &ReflectionModel, roi: &[Rect], margin| {
+            RegionKey::new(water, model, &[&plane], roi, &[], margin, shares, true)
+        };
+        let first = key(&broad, &model, &roi, 6);
+        assert_eq!(first, key(&broad, &model, &roi, 6));
+        let narrower = water_with_total(surface, [4e-3, 2.9999e-3]);
+        assert_ne!(first, key(&narrower, &model, &roi, 6));
+        assert_ne!(first, key(&ExactSurface, &model, &roi, 6));
+        let glossier = ReflectionModel {
+            gloss: 501.0,
+            ..model
+        };
+        assert_ne!(first, key(&broad, &glossier, &roi, 6));
+        assert_ne!(first, key(&broad, &model, &[rect(0.0, 3.0, 0.0, 2.001)], 6));
+        assert_ne!(first, key(&broad, &model, &roi, 7));
     }
 
     /// The separable dilation marks what marking each mark's square did: random marks on an
