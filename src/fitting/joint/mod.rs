@@ -145,12 +145,11 @@ pub use samples::effective_samples;
 pub use split::{Split, SplitWay};
 pub use uncertainty::{edge_statuses, Uncertainty, VarianceParts};
 
-use direct::direct_pixels;
 use direct_start::enclosing_image;
 pub use lamp_starts::place_starts;
 use optimise::{optimise, start_state};
 use problem::{Problem, State};
-use region::{region, region_of_interest, KeptRegion, RegionKey};
+use region::{fit_pixels, region_of_interest, RegionAsk};
 use repeats::mean_and_spread;
 use samples::sample_extent;
 use uncertainty::uncertainties;
@@ -254,72 +253,26 @@ pub fn fit_joint_with(
         gloss: options.region_gloss.unwrap_or(options.model.gloss),
         ..options.model
     };
-    let region_water = options.region_water.unwrap_or(water_model);
-    let region_read = |share| {
-        region(
-            region_water,
-            scene,
-            &probe_model,
-            &planes,
-            &roi,
-            photo,
-            water,
-            &used,
-            options.margin,
-            share,
-        )
+    let ask = RegionAsk {
+        water_model: options.region_water.unwrap_or(water_model),
+        model: &probe_model,
+        planes: &planes,
+        roi: &roi,
+        streaks: &used,
+        margin: options.margin,
+        shares: (
+            options.pixels,
+            options.share_for(images.iter().all(Option::is_some)),
+        ),
+        direct_view: options.direct_view,
     };
-    // Where every lamp pins its light and the water is plenty, one water pixel of each 2 x 2
-    // block (`JointOptions::thin_seen_whole`): those of the checkerboard's in even rows. Its
-    // region is the checkerboard's region's pixels it reads, so it is probed alone first.
-    let thinned = options.share_for(images.iter().all(Option::is_some));
-    let key = RegionKey::new(
-        region_water,
-        &probe_model,
-        &planes,
-        &roi,
-        &used,
-        options.margin,
-        (options.pixels, thinned),
-        options.direct_view,
+    let (pixels, first_direct, share) = fit_pixels(
+        scene,
+        photo,
+        water,
+        &ask,
+        options.reweight.map(|rw| &rw.cache.region),
     );
-    // A search's later fit reads the pixels of its first where they were made alike.
-    let kept = options
-        .reweight
-        .and_then(|rw| rw.cache.region.get())
-        .filter(|k| k.key == key);
-    let (pixels, share, first_direct) = match kept {
-        Some(k) => (k.pixels.clone(), k.share, k.first_direct),
-        None => {
-            let (mut pixels, share) =
-                match (thinned != options.pixels).then(|| region_read(thinned)) {
-                    Some(kept) if kept.len() >= THIN_MIN_WATER_PIXELS => (kept, thinned),
-                    _ => (region_read(options.pixels), options.pixels),
-                };
-            // The pixels that see the lights' walls directly follow the water pixels.
-            let first_direct = pixels.len();
-            if options.direct_view {
-                pixels.extend(direct_pixels(
-                    scene,
-                    &planes,
-                    &roi,
-                    photo.width,
-                    photo.height,
-                    water,
-                    share,
-                ));
-            }
-            if let Some(rw) = options.reweight {
-                let _ = rw.cache.region.set(KeptRegion {
-                    key,
-                    pixels: pixels.clone(),
-                    first_direct,
-                    share,
-                });
-            }
-            (pixels, share, first_direct)
-        }
-    };
     let trace = |planes: &[&LightPlane], roi: &[Rect], repeat: u32, draw: u32| {
         let fit = proposal::FitSamples {
             water_model,

@@ -5,11 +5,14 @@
 //! can reach a light's region of interest: a streak's faint ends fall below any
 //! segmentation's threshold, and an edge seen only through them would otherwise drift.
 
+use std::sync::OnceLock;
+
 use glam::Vec2;
 use rayon::prelude::*;
 
 use super::descent::first_window;
-use super::options::PixelShare;
+use super::direct::direct_pixels;
+use super::options::{PixelShare, THIN_MIN_WATER_PIXELS};
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::fitting::{FittedLight, StreakObservation};
@@ -188,11 +191,26 @@ fn sees_region_of_interest(
     })
 }
 
-/// What a joint fit's pixels depend on beyond the scene and the photo. A search's fits over
-/// one start agree on all of it, so the first one's pixels serve the rest
-/// ([`KeptRegion`], held by [`super::proposal::ProposalCache`]): probing the region and
-/// listing the pixels that see the walls took 12-20 ms a fit over the harbour pair, eight
-/// or nine fits a slope search.
+/// What a joint fit's pixels are made from, besides the scene and the photo: the probe's
+/// water model and reflection model, the lights' planes and regions of interest, the streaks
+/// they start from, the margin, the share of the water pixels asked for and the one a fit
+/// whose every lamp pins its light reads ([`super::JointOptions::share_for`]), and whether
+/// the pixels that see the walls directly are read.
+pub(super) struct RegionAsk<'a> {
+    pub(super) water_model: &'a dyn WaterModel,
+    pub(super) model: &'a ReflectionModel,
+    pub(super) planes: &'a [&'a LightPlane],
+    pub(super) roi: &'a [Rect],
+    pub(super) streaks: &'a [&'a StreakObservation],
+    pub(super) margin: u32,
+    pub(super) shares: (PixelShare, PixelShare),
+    pub(super) direct_view: bool,
+}
+
+/// A [`RegionAsk`] to compare: a search's fits over one start ask alike, so the first one's
+/// pixels serve the rest ([`KeptRegion`], held by [`super::proposal::ProposalCache`]):
+/// probing the region and listing the pixels that see the walls took 12-20 ms a fit over
+/// the harbour pair, eight to ten fits a slope search.
 #[derive(Debug, PartialEq)]
 pub(super) struct RegionKey {
     /// The probe's water model and reflection model as their debug text: every field, each
@@ -200,48 +218,92 @@ pub(super) struct RegionKey {
     models: String,
     planes: Vec<LightPlane>,
     roi: Vec<Rect>,
-    /// The streaks the lights start from (their pixels seed the region).
     streaks: Vec<usize>,
     margin: u32,
-    /// The share of the water pixels asked for, and the one a fit thinned where every lamp
-    /// pins its light would read.
-    asked: PixelShare,
-    thinned: PixelShare,
+    shares: (PixelShare, PixelShare),
     direct_view: bool,
 }
 
 impl RegionKey {
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn new(
-        probe_water: &dyn WaterModel,
-        probe_model: &ReflectionModel,
-        planes: &[&LightPlane],
-        roi: &[Rect],
-        streaks: &[&StreakObservation],
-        margin: u32,
-        (asked, thinned): (PixelShare, PixelShare),
-        direct_view: bool,
-    ) -> Self {
+    fn of(ask: &RegionAsk<'_>) -> Self {
         RegionKey {
-            models: format!("{probe_water:?} {probe_model:?}"),
-            planes: planes.iter().map(|p| (*p).clone()).collect(),
-            roi: roi.to_vec(),
-            streaks: streaks.iter().map(|s| s.id).collect(),
-            margin,
-            asked,
-            thinned,
-            direct_view,
+            models: format!("{:?} {:?}", ask.water_model, ask.model),
+            planes: ask.planes.iter().map(|p| (*p).clone()).collect(),
+            roi: ask.roi.to_vec(),
+            streaks: ask.streaks.iter().map(|s| s.id).collect(),
+            margin: ask.margin,
+            shares: ask.shares,
+            direct_view: ask.direct_view,
         }
     }
 }
 
-/// A fit's pixels as its region made them: the water pixels, then from `first_direct` on
-/// those that see a light's wall directly, the water read at `share`.
+/// A fit's pixels as [`fit_pixels`] made them, with what they were made from.
 pub(super) struct KeptRegion {
-    pub(super) key: RegionKey,
-    pub(super) pixels: Vec<u32>,
-    pub(super) first_direct: usize,
-    pub(super) share: PixelShare,
+    key: RegionKey,
+    pixels: Vec<u32>,
+    first_direct: usize,
+    share: PixelShare,
+}
+
+/// The pixels a joint fit reads: the water pixels of its region ([`region`]), then, when
+/// the direct view is read, those that see a light's wall directly ([`direct_pixels`]),
+/// with the index of the first of those and the share of the water they read. Where every
+/// lamp pins its light and the water is plenty, one water pixel of each 2 x 2 block
+/// (`JointOptions::thin_seen_whole`): its region is the checkerboard's region's pixels it
+/// reads, so it is probed alone first. A search's later fit takes them from `kept`, where its
+/// first fit left them, when it asks alike.
+pub(super) fn fit_pixels(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    ask: &RegionAsk<'_>,
+    kept: Option<&OnceLock<KeptRegion>>,
+) -> (Vec<u32>, usize, PixelShare) {
+    let key = RegionKey::of(ask);
+    if let Some(k) = kept.and_then(OnceLock::get).filter(|k| k.key == key) {
+        return (k.pixels.clone(), k.first_direct, k.share);
+    }
+    let read = |share| {
+        region(
+            ask.water_model,
+            scene,
+            ask.model,
+            ask.planes,
+            ask.roi,
+            photo,
+            water,
+            ask.streaks,
+            ask.margin,
+            share,
+        )
+    };
+    let (asked, thinned) = ask.shares;
+    let (mut pixels, share) = match (thinned != asked).then(|| read(thinned)) {
+        Some(kept) if kept.len() >= THIN_MIN_WATER_PIXELS => (kept, thinned),
+        _ => (read(asked), asked),
+    };
+    let first_direct = pixels.len();
+    if ask.direct_view {
+        pixels.extend(direct_pixels(
+            scene,
+            ask.planes,
+            ask.roi,
+            photo.width,
+            photo.height,
+            water,
+            share,
+        ));
+    }
+    if let Some(kept) = kept {
+        let _ = kept.set(KeptRegion {
+            key,
+            pixels: pixels.clone(),
+            first_direct,
+            share,
+        });
+    }
+    (pixels, first_direct, share)
 }
 
 /// Where on its plane a light's edges may go during the fit: samples landing outside it are
@@ -343,8 +405,17 @@ mod tests {
         let model = ReflectionModel::new(500.0, 1.33);
         let roi = [rect(0.0, 3.0, 0.0, 2.0)];
         let shares = (PixelShare::Checkerboard, PixelShare::Quarter);
-        let key = |water: &dyn WaterModel, model: &ReflectionModel, roi: &[Rect], margin| {
-            RegionKey::new(water, model, &[&plane], roi, &[], margin, shares, true)
+        let key = |water_model: &dyn WaterModel, model: &ReflectionModel, roi: &[Rect], margin| {
+            RegionKey::of(&RegionAsk {
+                water_model,
+                model,
+                planes: &[&plane],
+                roi,
+                streaks: &[],
+                margin,
+                shares,
+                direct_view: true,
+            })
         };
         let first = key(&broad, &model, &roi, 6);
         assert_eq!(first, key(&broad, &model, &roi, 6));
