@@ -149,6 +149,13 @@ fn non_triangles_are_skipped_and_degenerate_triangles_counted() {
     let scene = load(&dir.join("s.gltf"), &opts()).unwrap();
     assert_eq!(scene.dropped_triangles, 2);
     assert_eq!(scene.triangles.len(), 48 * 23 * 2 + 2 + 1);
+    // The good one is kept last, its corners and its (face) normals together.
+    let (t, n) = (
+        scene.triangles.last().unwrap(),
+        scene.normals.last().unwrap(),
+    );
+    assert_eq!((t[1] - t[0], t[2] - t[0]), (glam::Vec3::X, glam::Vec3::Y));
+    assert_eq!(*n, [glam::Vec3::Z; 3]);
     assert!(scene.warnings.iter().any(|w| w.contains("not triangles")));
     assert!(scene.warnings.iter().any(|w| w.contains("2 degenerate")));
 }

@@ -293,7 +293,8 @@ fn add_primitive(
         .unzip_into_vecs(&mut kept_positions, &mut kept_normals);
     let dropped = kept_positions.iter().filter(|v| v[0].is_nan()).count();
     if dropped > 0 {
-        kept_normals.retain(|n| !n[0].is_nan());
+        let mut kept = kept_positions.iter().map(|v| !v[0].is_nan());
+        kept_normals.retain(|_| kept.next().unwrap_or(false));
         kept_positions.retain(|v| !v[0].is_nan());
     }
     out.dropped += dropped;
