@@ -51,7 +51,9 @@ fn estimate_with(
         close_regions,
         ..JointOptions::new(paper.model, seed)
     };
-    estimate_gloss(scene, photo, water, streaks, &paper, &final_fit, search)
+    estimate_gloss(
+        scene, photo, water, streaks, &paper, None, &final_fit, search,
+    )
 }
 
 /// Estimates the gloss of a sample photo, starting from the scene's own gloss (500).

@@ -220,6 +220,7 @@ fn other_waves_end_a_gloss_search_at_its_first_fit() {
             seed: 1,
             model,
         },
+        None,
         &JointOptions {
             start_gate: Some(StartGate(&gate)),
             ..JointOptions::new(model, 1)

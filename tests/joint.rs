@@ -129,7 +129,11 @@ const LIGHT0_BOUND: f64 = 0.005;
 #[test]
 fn joint_fits_table1() {
     let truth = samples::table1_light();
-    let joint = fit("table1.png", Method::default());
+    let report = fit_report("table1.png", Method::default(), 1);
+    // The lamp is in the photo, whole: its image pins the light, and the paper's estimate
+    // that starts the fit reads 32 lobe samples a pixel, not 128.
+    assert_eq!(report.settings.samples, 32);
+    let joint = report.lights;
     let paper = fit("table1.png", Method::Paper);
     assert_eq!(joint.len(), 1);
     let (je, jr) = errors(&joint[0], &truth);
@@ -207,12 +211,14 @@ fn a_start_moved_onto_a_cut_image_keeps_its_extent_beyond_the_cut() {
 fn joint_fits_table3() {
     let truths = samples::table3_lights();
     let report = fit_report("table3.png", Method::default(), 1);
-    // Light1's lamp is cut by the frame: its reflections must place its edges, and the fit
-    // reads the checkerboard.
+    // Light1's lamp is cut by the frame: its reflections must place its edges, the fit
+    // reads the checkerboard, and starts from the paper's estimate at 128 lobe samples a
+    // pixel (its first try at 32 not kept).
     assert_eq!(
         report.settings.joint_pixels.as_deref(),
         Some("checkerboard")
     );
+    assert_eq!(report.settings.samples, 128);
     // Two streaks, one light each: nothing to warn about overlapping reflections.
     assert!(
         report.warnings.iter().all(|w| !w.contains("overlap")),

@@ -4,8 +4,8 @@
 
 use streaklight::limits::check_cap;
 
-/// `fit --samples` (default 512, or 128 where the estimate starts the exact model's joint
-/// fit): lobe samples per traced pixel of the paper's estimate.
+/// `fit --samples` (default 512, or 32-128 where the estimate starts a joint fit): lobe
+/// samples per traced pixel of the paper's estimate.
 pub const SAMPLES: u64 = 65_536;
 /// `fit --joint-samples` (default 72): the joint fit's time grows in proportion.
 pub const JOINT_SAMPLES: u64 = 8_192;

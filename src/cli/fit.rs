@@ -88,9 +88,10 @@ pub struct Args {
     pub exposure: ExposureArg,
     /// Lobe samples per traced pixel of the per-streak estimate (1 or more; typical 64-2048;
     /// its time grows in proportion). Default: 512 where the estimate is the result (--method
-    /// paper), 128 where it starts the exact model's joint fit (which moves every edge from
-    /// there); as the statistical water model's start, 128 when every light it starts lies on
-    /// its lamp's whole image in the photo, else 512.
+    /// paper); where it starts the exact model's joint fit (which moves every edge from
+    /// there), 32 when every light it starts lies on its lamp's whole image in the photo
+    /// (which pins it), else 128; as the statistical water model's start, 128 when every
+    /// light lies so, else 512.
     #[arg(long, value_name = "N", value_parser = super::values::count)]
     pub samples: Option<u32>,
     /// Seed of every random number, 0 to 2^64-1: the same inputs and seed give the same

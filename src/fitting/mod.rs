@@ -78,10 +78,17 @@ pub const DEFAULT_SAMPLES: u32 = 512;
 /// exact model's joint fit: the joint fit's descent moves every edge from there, and its
 /// first search window spans half the light's size. On the samples the lights came out
 /// within 0.1 % of those from 512 samples (at most 0.6 of a sigma apart), in a quarter of
-/// the estimate's time (docs/decisions.md). The statistical model's start tries it first too,
-/// and keeps it where every light it starts is pinned by its lamp's image
-/// ([`crate::pipeline::FitSettings::quick_statistical_samples`]).
+/// the estimate's time (docs/decisions.md). The statistical model's start tries it first
+/// ([`crate::pipeline::FitSettings::quick_start_samples`]).
 pub const DEFAULT_START_SAMPLES: u32 = 128;
+
+/// Lobe samples per traced pixel of the exact model's start where the joint fit reads the
+/// direct view: the estimate is kept where every light it starts lies on a lamp's whole
+/// direct image, which pins the light whatever the start's noise
+/// ([`joint::start_estimate`]), and made again at [`DEFAULT_START_SAMPLES`] otherwise. On
+/// the samples in frame the lights came out within 0.03 % of those from 128 samples, in a
+/// quarter of the estimate's time (docs/decisions.md).
+pub const QUICK_START_SAMPLES: u32 = 32;
 
 /// The most pixels one parallel task traces. Rayon otherwise cuts a list into a few long
 /// tasks per core; a pixel's cost varies many times over (those whose lobes reach a light

@@ -27,7 +27,8 @@ pub use water_choice::{
 use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
 use crate::fitting::joint::{
-    fit_joint_with, JointOptions, PixelShare, Split, StartGate, Uncertainty,
+    fit_joint_with, place_starts, start_estimate, JointOptions, PixelShare, PlacedStart, Split,
+    StartEstimate, StartGate, Uncertainty,
 };
 use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
@@ -77,6 +78,10 @@ pub struct Lit {
     /// fitted; `None` for a black night, a blank photo, a photo without streaks, or when
     /// [`FitSettings::background`] is off.
     pub background: Option<Background>,
+    /// Lobe samples per traced pixel of the paper's estimate the fit started from (or that
+    /// is the result, for the paper's method): [`FitSettings::paper_samples`], or fewer where
+    /// [`FitSettings::quick_start_samples`]' first try was kept.
+    pub start_samples: u32,
 }
 
 /// Which input a message is about.
@@ -196,7 +201,8 @@ pub fn fit(
         water: &water,
         observations: &observations,
         statistical_samples: settings.paper_samples(true),
-        quick_statistical_samples: settings.quick_statistical_samples(),
+        quick_statistical_samples: settings.quick_start_samples(true),
+        quick_exact_samples: settings.quick_start_samples(false),
         water_stats: std::cell::OnceCell::new(),
         paper: FitOptions {
             samples: settings.paper_samples(false),
@@ -225,6 +231,7 @@ pub fn fit(
         stopped_at_start: false,
         ended_at_split: false,
         share: None,
+        start_samples: settings.paper_samples(false),
     };
     let water_model = if observations.is_empty() {
         match settings.water {
@@ -273,6 +280,7 @@ pub fn fit(
         nothing_found,
         timings: clock.timings,
         background,
+        start_samples: found.start_samples,
     })
 }
 
@@ -298,6 +306,8 @@ struct Found {
     ended_at_split: bool,
     /// Which pixels the last joint fit read (`None`: as its reading gives them).
     share: Option<PixelShare>,
+    /// Lobe samples per traced pixel of the paper's estimate the fit started from.
+    start_samples: u32,
 }
 
 impl Found {
@@ -327,32 +337,67 @@ struct Run<'a> {
     /// ([`FitSettings::paper_samples`]).
     statistical_samples: u32,
     /// The samples of the statistical start's first try
-    /// ([`FitSettings::quick_statistical_samples`]).
+    /// ([`FitSettings::quick_start_samples`]).
     quick_statistical_samples: Option<u32>,
+    /// The samples of the exact model's start's first try, where a joint fit reading the
+    /// direct view follows ([`FitSettings::quick_start_samples`]).
+    quick_exact_samples: Option<u32>,
     /// What the camera sees of the scene's water, once asked for.
     water_stats: std::cell::OnceCell<Option<WaterStatistics>>,
     progress: Reporter<'a>,
 }
 
 impl Run<'_> {
-    /// The paper's estimate (method §5 steps 7-9).
-    fn paper(&self, found: &mut Found) -> Result<()> {
+    /// The paper's estimate (method §5 steps 7-9). Where it starts a joint fit `j` that reads
+    /// the direct view, it is first made with few samples ([`start_estimate`]); returns its
+    /// lights as placed on their lamps' images when that estimate was kept.
+    fn paper(&self, found: &mut Found, j: Option<&JointSettings>) -> Result<Option<PlacedStart>> {
         self.progress.stage(&format!(
             "fit of {} streak(s): the paper's estimate",
             self.observations.len()
         ));
-        let f = fitting::fit_paper(
+        let quick = j.filter(|j| j.direct_view).and(self.quick_exact_samples);
+        let estimate = |samples: u32| {
+            fitting::fit_paper(
+                self.scene,
+                self.photo,
+                self.water,
+                self.observations,
+                &FitOptions {
+                    samples,
+                    ..self.paper
+                },
+            )
+        };
+        let place = |fit: &fitting::FitOutcome| {
+            Ok(place_starts(
+                self.scene,
+                self.photo,
+                self.water,
+                self.observations,
+                &fit.lights,
+                self.progress,
+            ))
+        };
+        let StartEstimate {
+            fit,
+            placed,
+            samples,
+        } = start_estimate(
             self.scene,
             self.photo,
             self.water,
-            self.observations,
-            &self.paper,
+            quick,
+            self.paper.samples,
+            &estimate,
+            &place,
         )?;
-        found.lights = f.lights;
-        found.skipped = f.skipped;
-        found.warnings.extend(f.warnings);
-        found.timings = f.timings;
-        Ok(())
+        found.lights = fit.lights;
+        found.skipped = fit.skipped;
+        found.warnings.extend(fit.warnings);
+        found.timings = fit.timings;
+        found.start_samples = samples;
+        Ok(placed)
     }
 
     /// The joint fit's options for `reading`.
@@ -404,18 +449,29 @@ impl Run<'_> {
         Ok(())
     }
 
-    /// The joint fit from the paper's lights in `found`, then the refit of lights that share
-    /// a streak; `gate` may end the fit at its start ([`JointOptions::start_gate`]).
+    /// The joint fit from the paper's lights in `found` (or from `placed`, those lights placed
+    /// on their lamps' images already), then the refit of lights that share a streak; `gate`
+    /// may end the fit at its start ([`JointOptions::start_gate`]).
     fn refine(
         &self,
         j: &JointSettings,
         found: &mut Found,
         gate: Option<StartGate<'_>>,
+        placed: Option<PlacedStart>,
     ) -> Result<()> {
+        let paper_lights = std::mem::take(&mut found.lights);
+        let starts_placed = placed.is_some();
+        let (start, images) = match placed {
+            Some(p) => (p.lights, p.images),
+            None => (paper_lights, Vec::new()),
+        };
         self.progress
-            .stage(&format!("joint fit of {} light(s)", found.lights.len()));
-        let start = std::mem::take(&mut found.lights);
-        let options = self.joint_options(j, j.reading);
+            .stage(&format!("joint fit of {} light(s)", start.len()));
+        let options = JointOptions {
+            starts_placed,
+            start_images: &images,
+            ..self.joint_options(j, j.reading)
+        };
         // Where lights that share a streak are fitted again, the first fit's work past its
         // split would be thrown away: it ends there.
         let first = JointOptions {
@@ -485,12 +541,14 @@ impl Run<'_> {
             self.water,
             self.observations,
             &self.paper,
+            self.quick_exact_samples,
             &JointOptions {
                 start_gate: gate,
                 ..final_fit
             },
             search,
         )?;
+        found.start_samples = estimate.start_samples;
         if estimate.stopped_at_start {
             found.skipped = estimate.skipped;
             found.warnings.extend(estimate.warnings);

@@ -5,7 +5,7 @@
 use super::water_choice::WaterChoice;
 use crate::fitting::gloss::GlossSearch;
 use crate::fitting::joint::{PixelShare, DEFAULT_JOINT_SAMPLES};
-use crate::fitting::{DEFAULT_SAMPLES, DEFAULT_START_SAMPLES};
+use crate::fitting::{DEFAULT_SAMPLES, DEFAULT_START_SAMPLES, QUICK_START_SAMPLES};
 use crate::optics::Shadowing;
 use crate::settings::Setting;
 use crate::streaks::StreakParams;
@@ -16,7 +16,7 @@ use crate::{Error, Result};
 pub struct FitSettings {
     /// Lobe samples per traced pixel of the paper's estimate (method §5 steps 7-9); `None`:
     /// [`DEFAULT_SAMPLES`], or [`DEFAULT_START_SAMPLES`] where the estimate starts the exact
-    /// model's joint fit ([`Self::paper_samples`], [`Self::quick_statistical_samples`]). The
+    /// model's joint fit ([`Self::paper_samples`], [`Self::quick_start_samples`]). The
     /// edge solutions average over tens of pixels, so a few hundred suffice.
     pub samples: Option<u32>,
     /// Seed of every random number of the fit: the same inputs and seed give the same lights.
@@ -202,7 +202,7 @@ impl FitSettings {
     /// estimate starts the exact model's joint fit and [`DEFAULT_SAMPLES`] where it is the
     /// result (the paper's method) or starts the statistical model's slope search (out of
     /// frame its fits descend from the start, and its noise moved their lights by tens of
-    /// percent: docs/decisions.md), unless [`Self::quick_statistical_samples`]' first try is
+    /// percent: docs/decisions.md), unless [`Self::quick_start_samples`]' first try is
     /// kept.
     pub fn paper_samples(&self, statistical: bool) -> u32 {
         self.samples.unwrap_or(match self.method {
@@ -211,13 +211,20 @@ impl FitSettings {
         })
     }
 
-    /// The samples per traced pixel of a first, cheaper estimate the statistical model's
-    /// slope search tries as its start: kept when every light it starts lies on a lamp's
-    /// whole direct image, which then pins it ([`crate::fitting::slopes::estimate_slopes`]).
-    /// [`DEFAULT_START_SAMPLES`] for the joint method unless `--samples` was given.
-    pub fn quick_statistical_samples(&self) -> Option<u32> {
+    /// The samples per traced pixel of a first, cheaper paper's estimate that starts a joint
+    /// fit under the water model `statistical` or the exact one: kept when every light it
+    /// starts lies on a lamp's whole direct image, which then pins it
+    /// ([`crate::fitting::joint::start_estimate`]). For the joint method unless `--samples`
+    /// was given: [`QUICK_START_SAMPLES`] under the exact model, [`DEFAULT_START_SAMPLES`]
+    /// under the statistical one, whose slope search read other variances from the fewer
+    /// (docs/decisions.md).
+    pub fn quick_start_samples(&self, statistical: bool) -> Option<u32> {
         match self.method {
-            Method::Joint(_) if self.samples.is_none() => Some(DEFAULT_START_SAMPLES),
+            Method::Joint(_) if self.samples.is_none() => Some(if statistical {
+                DEFAULT_START_SAMPLES
+            } else {
+                QUICK_START_SAMPLES
+            }),
             _ => None,
         }
     }
@@ -262,21 +269,23 @@ mod tests {
     }
 
     /// The paper's estimate reads 128 samples where it only starts the exact model's joint
-    /// fit, 512 where it is the result or the statistical model's start (which tries 128
-    /// first), and what was asked for wherever it was asked.
+    /// fit (which tries 32 first), 512 where it is the result or the statistical model's
+    /// start (which tries 128 first), and what was asked for wherever it was asked.
     #[test]
     fn the_paper_estimates_samples_follow_its_use() {
         let joint = FitSettings::default();
         assert_eq!(joint.paper_samples(false), 128);
         assert_eq!(joint.paper_samples(true), 512);
-        assert_eq!(joint.quick_statistical_samples(), Some(128));
+        assert_eq!(joint.quick_start_samples(false), Some(32));
+        assert_eq!(joint.quick_start_samples(true), Some(128));
         let paper = FitSettings {
             method: Method::Paper,
             ..FitSettings::default()
         };
         assert_eq!(paper.paper_samples(false), 512);
         assert_eq!(paper.paper_samples(true), 512);
-        assert_eq!(paper.quick_statistical_samples(), None);
+        assert_eq!(paper.quick_start_samples(false), None);
+        assert_eq!(paper.quick_start_samples(true), None);
         for method in [Method::Paper, Method::default()] {
             let asked = FitSettings {
                 samples: Some(64),
@@ -285,7 +294,8 @@ mod tests {
             };
             assert_eq!(asked.paper_samples(false), 64);
             assert_eq!(asked.paper_samples(true), 64);
-            assert_eq!(asked.quick_statistical_samples(), None);
+            assert_eq!(asked.quick_start_samples(false), None);
+            assert_eq!(asked.quick_start_samples(true), None);
         }
     }
 

@@ -184,10 +184,14 @@ impl Run<'_> {
                 self.with_gloss_search(j, found, gate)
             }
             method => {
-                self.paper(found)?;
-                if let Method::Joint(j) = method {
+                let joint = match method {
+                    Method::Joint(j) => Some(j),
+                    Method::Paper => None,
+                };
+                let placed = self.paper(found, joint)?;
+                if let Some(j) = joint {
                     if !found.lights.is_empty() {
-                        self.refine(j, found, gate)?;
+                        self.refine(j, found, gate, placed)?;
                     }
                 }
                 Ok(())
@@ -254,6 +258,7 @@ impl Run<'_> {
                 found.skipped = f.skipped;
                 found.warnings.extend(f.warnings);
                 found.timings.extend(f.timings);
+                found.start_samples = self.statistical_samples;
                 SlopesUsed {
                     variance: start,
                     sigma_ln: [None, None],
@@ -303,6 +308,7 @@ impl Run<'_> {
                 found.splits = est.splits;
                 found.reading = Some(j.reading);
                 found.share = Some(est.share);
+                found.start_samples = est.start_samples;
                 let estimated = !found.lights.is_empty();
                 if estimated {
                     self.refit_overlaps(&est.water, &est.start, &final_fit, j, found)?;

@@ -59,11 +59,7 @@ pub fn build(scene: &Scene, lit: &Lit, run: Run<'_>) -> Report {
                 Shadowing::None => "none".into(),
                 Shadowing::Smith => "smith".into(),
             },
-            samples: lit
-                .water_model
-                .slopes
-                .as_ref()
-                .map_or(settings.paper_samples(false), |s| s.start_samples),
+            samples: lit.start_samples,
             seed: settings.seed,
             repeats: joint.map_or(1, |j| j.repeats),
             joint_samples: lit.reading.map(|r| effective_samples(r.samples)),

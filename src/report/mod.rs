@@ -83,7 +83,7 @@ pub struct Settings {
     pub shadowing: String,
     /// Lobe samples per traced pixel of the paper's estimate the fit started from, under the
     /// water model used ([`crate::pipeline::FitSettings::paper_samples`],
-    /// [`crate::pipeline::FitSettings::quick_statistical_samples`]).
+    /// [`crate::pipeline::FitSettings::quick_start_samples`]).
     pub samples: u32,
     /// Seed of every random number.
     pub seed: u64,

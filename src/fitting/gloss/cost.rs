@@ -59,6 +59,9 @@ pub(super) struct Cost<'a> {
     pub(super) water: &'a [bool],
     pub(super) streaks: &'a [StreakObservation],
     pub(super) start: &'a [FittedLight],
+    /// Where each start light's lamp ends, when the start's estimate found it
+    /// ([`JointOptions::start_images`]).
+    pub(super) start_images: &'a [Option<(Rect, f32)>],
     pub(super) options: &'a GlossSearch,
     pub(super) fit: SearchFit<'a>,
     /// The trace every fit weighs (module doc).
@@ -109,6 +112,7 @@ impl Curve for &mut Cost<'_> {
                 }),
                 start_gate: self.gate.filter(|_| self.evaluations.is_empty()),
                 starts_placed: true,
+                start_images: self.start_images,
                 held: self.held.as_deref().unwrap_or(&[]),
                 progress: self.fit.progress,
                 ..JointOptions::new(

@@ -122,10 +122,10 @@ pub(super) mod search;
 use std::time::Instant;
 
 use super::joint::{
-    fit_joint, place_starts, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache,
-    Reweight, Split, Uncertainty, DEFAULT_JOINT_SAMPLES,
+    fit_joint, place_starts, start_estimate, JointOptions, Lobe, ModelledPixel, PixelShare,
+    ProposalCache, Reweight, Split, StartEstimate, Uncertainty, DEFAULT_JOINT_SAMPLES,
 };
-use super::{fit_paper, FitOptions, FittedLight, Skipped, StreakObservation};
+use super::{fit_paper, FitOptions, FitOutcome, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
@@ -273,6 +273,8 @@ pub struct GlossEstimate {
     /// ([`JointOptions::start_gate`] of the final fit's options) said so: then there is no
     /// estimate and no light, and `modelled` is that fit's start image.
     pub stopped_at_start: bool,
+    /// Lobe samples per traced pixel of the paper's estimate every fit started from.
+    pub start_samples: u32,
 }
 
 /// Estimates the water's gloss from the photo and fits the lights with it (see the module
@@ -280,17 +282,20 @@ pub struct GlossEstimate {
 ///
 /// The inputs are those of [`fit_paper`]: the photo, its water mask and the streaks found in
 /// it. `paper` is the paper fit that gives every candidate its start (its `model.gloss` is
-/// the first guess, the scene's typically; its seed is also the search's fits'); `final_fit`
+/// the first guess, the scene's typically; its seed is also the search's fits'), first made
+/// with `quick_samples` when given ([`start_estimate`]); `final_fit`
 /// is the joint fit run at the estimate (its model's gloss is replaced by the estimate; its
 /// progress reporter hears each evaluation). Fails on inconsistent inputs, bad search
 /// options, when there is no streak, and when no streak gives a light (the message says why
 /// for each).
+#[allow(clippy::too_many_arguments)]
 pub fn estimate_gloss(
     scene: &Scene,
     photo: &Photo,
     water: &[bool],
     streaks: &[StreakObservation],
     paper: &FitOptions,
+    quick_samples: Option<u32>,
     final_fit: &JointOptions,
     options: &GlossSearch,
 ) -> Result<GlossEstimate> {
@@ -327,16 +332,45 @@ pub fn estimate_gloss(
         direct_view: final_fit.direct_view,
         close_regions: final_fit.close_regions,
     };
-    let paper = fit_paper(scene, photo, water, streaks, &start_options)?;
-    timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
-    let start = search_start(&paper, streaks.len(), "gloss")?;
-    let mut warnings = paper.warnings.clone();
     // Every fit starts alike: the direct view places the starts once.
-    let start = if final_fit.direct_view {
-        place_starts(scene, photo, water, streaks, &start, final_fit.progress)
-    } else {
-        start
+    let place = |fit: &FitOutcome| -> Result<Vec<FittedLight>> {
+        let start = search_start(fit, streaks.len(), "gloss")?;
+        Ok(if final_fit.direct_view {
+            place_starts(scene, photo, water, streaks, &start, final_fit.progress)
+        } else {
+            start
+        })
     };
+    let StartEstimate {
+        fit: paper,
+        placed,
+        samples: start_samples,
+    } = start_estimate(
+        scene,
+        photo,
+        water,
+        quick_samples.filter(|_| final_fit.direct_view),
+        start_options.samples,
+        &|samples| {
+            fit_paper(
+                scene,
+                photo,
+                water,
+                streaks,
+                &FitOptions {
+                    samples,
+                    ..start_options
+                },
+            )
+        },
+        &place,
+    )?;
+    timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
+    let (start, start_images) = match placed {
+        Some(p) => (p.lights, p.images),
+        None => (place(&paper)?, Vec::new()),
+    };
+    let mut warnings = paper.warnings.clone();
 
     let t = Instant::now();
     let mut cost = Cost {
@@ -345,6 +379,7 @@ pub fn estimate_gloss(
         water,
         streaks,
         start: &start,
+        start_images: &start_images,
         options,
         fit: search_fit,
         proposal: ProposalCache::new(proposal(x0)),
@@ -398,6 +433,7 @@ pub fn estimate_gloss(
             share: options.search_pixels,
             splits: Vec::new(),
             stopped_at_start: true,
+            start_samples,
         });
     }
     timings.push((
@@ -447,6 +483,7 @@ pub fn estimate_gloss(
                 region_gloss: Some(cost::region_gloss(options, search_fit.model.gloss)),
                 close_regions: search_fit.close_regions,
                 starts_placed: true,
+                start_images: &start_images,
                 reweight: Some(Reweight {
                     cache,
                     target: Lobe::Exact { gloss },
@@ -482,5 +519,6 @@ pub fn estimate_gloss(
         share: final_fit.share,
         splits: final_fit.splits,
         stopped_at_start: false,
+        start_samples,
     })
 }

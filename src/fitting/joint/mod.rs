@@ -69,6 +69,7 @@
 //! | `direct_images` | a lamp's image in the photo: the bright pixels that see its wall |
 //! | `direct_start` | starts far from a light's direct image moved onto it, fragments merged |
 //! | `lamp_starts` | one start per lamp whose reflections share a streak with another's |
+//! | `start_estimate` | the paper's estimate that starts a fit, with few samples where lamps pin it |
 //! | `samples`, `trace` | the stored plane samples, a coefficient from them; their trace |
 //! | `reweight` | a search's samples from one trace, weighted for each fit's lobe |
 //! | `proposal` | the lobe that trace is drawn from, the targets it serves |
@@ -131,6 +132,7 @@ mod samples;
 mod significance;
 mod split;
 mod stacked;
+mod start_estimate;
 mod store;
 mod trace;
 mod uncertainty;
@@ -152,6 +154,7 @@ use problem::{Problem, State};
 use region::{fit_pixels, region_of_interest, RegionAsk};
 use repeats::mean_and_spread;
 use samples::sample_extent;
+pub use start_estimate::{start_estimate, PlacedStart, StartEstimate};
 use uncertainty::uncertainties;
 
 /// Refines `start` (typically the paper's per-streak estimate) by fitting all lights together
@@ -235,11 +238,15 @@ pub fn fit_joint_with(
     // fit that may thin its pixels does (`JointOptions::share_for`).
     let may_thin = options.share_for(true) != options.pixels;
     // A glitter-weighted fit reads them too (`weights_at_start` below).
+    let given = (options.start_images.len() == start.len()).then_some(options.start_images);
     let images: Vec<Option<(Rect, f32)>> = start
         .iter()
-        .map(|light| {
+        .enumerate()
+        .map(|(k, light)| {
             (options.direct_view && (options.close_regions || may_thin || options.glitter_weights))
-                .then(|| enclosing_image(scene, photo, water, light))
+                .then(|| {
+                    given.map_or_else(|| enclosing_image(scene, photo, water, light), |g| g[k])
+                })
                 .flatten()
         })
         .collect();

@@ -115,6 +115,12 @@ pub struct JointOptions<'a> {
     /// ([`place_starts`](super::place_starts)): the fit takes them as they are. A search
     /// whose fits all start from the same lights places them once. Off by default.
     pub starts_placed: bool,
+    /// Where each start light's lamp ends, one entry per start light as the fit takes them:
+    /// its whole direct image's rectangle and a pixel's footprint there, as the fit would
+    /// find it (`direct_start::enclosing_image`), given by a caller that found them already
+    /// ([`start_estimate`](super::start_estimate)). Used only when its length is the start
+    /// lights' count; empty by default.
+    pub start_images: &'a [Option<(Rect, f32)>],
     /// Where every start light lies on a lamp's whole direct image, read one water pixel of
     /// each 2 x 2 block instead of the [`PixelShare::Checkerboard`] (the pixels that see a
     /// light directly stay a checkerboard), if that still reads at least
@@ -169,6 +175,7 @@ impl JointOptions<'_> {
             held: &[],
             resume: &[],
             starts_placed: false,
+            start_images: &[],
             thin_seen_whole: false,
         }
     }

@@ -60,10 +60,9 @@ pub use uncertainty::{
 
 use super::gloss::search::{search, Point, Stop};
 use super::gloss::{search_start, GlossSearch};
-use super::joint::direct_start::enclosing_image;
 use super::joint::{
-    fit_joint_with, place_starts, JointOptions, Lobe, PixelShare, ProposalCache, Reweight, Split,
-    Uncertainty,
+    fit_joint_with, place_starts, start_estimate, JointOptions, Lobe, PixelShare, ProposalCache,
+    Reweight, Split, StartEstimate, Uncertainty,
 };
 use super::{
     fit_paper_with, FitOptions, FitOutcome, FittedLight, Rect, Skipped, StreakObservation,
@@ -203,29 +202,21 @@ pub fn estimate_slopes(
             start
         })
     };
-    let quick = quick_samples.filter(|&q| q < paper.samples && final_fit.direct_view);
-    let mut start_samples = quick.unwrap_or(paper.samples);
-    let mut paper_fit = estimate(start_samples)?;
-    let mut placed_start = None;
-    if quick.is_some() {
-        // Out of frame the reflections alone place the lights, every fit of the search
-        // descends from the start, and a noisier start moves them (docs/decisions.md).
-        let start = (!paper_fit.lights.is_empty())
-            .then(|| placed(&paper_fit))
-            .transpose()?
-            .filter(|start| {
-                start
-                    .iter()
-                    .all(|light| enclosing_image(scene, photo, water, light).is_some())
-            });
-        match start {
-            Some(start) => placed_start = Some(start),
-            None => {
-                start_samples = paper.samples;
-                paper_fit = estimate(start_samples)?;
-            }
-        }
-    }
+    // Out of frame the reflections alone place the lights, every fit of the search descends
+    // from the start, and a noisier start moves them (docs/decisions.md).
+    let StartEstimate {
+        fit: paper_fit,
+        placed: placed_start,
+        samples: start_samples,
+    } = start_estimate(
+        scene,
+        photo,
+        water,
+        quick_samples.filter(|_| final_fit.direct_view),
+        paper.samples,
+        &estimate,
+        &placed,
+    )?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
     if paper_fit.lights.is_empty() {
         // No light to estimate the slopes with: the caller reports the streaks skipped, as
@@ -249,9 +240,9 @@ pub fn estimate_slopes(
             share: final_fit.pixels,
         });
     }
-    let start = match placed_start {
-        Some(start) => start,
-        None => placed(&paper_fit)?,
+    let (start, start_images) = match placed_start {
+        Some(p) => (p.lights, p.images),
+        None => (placed(&paper_fit)?, Vec::new()),
     };
     let mut warnings = paper_fit.warnings.clone();
     let broad = water_with_total(surface, start_variance.map(|v| (4.0 * v).min(hi)));
@@ -272,6 +263,7 @@ pub fn estimate_slopes(
         // Every fit of the search starts alike, so each thins alike.
         thin_seen_whole: final_fit.thin_seen_whole,
         starts_placed: true,
+        start_images: &start_images,
         ..JointOptions::new(model, paper.seed)
     };
     // Each axis's last pass: (ln variance, the lights fitted there).
@@ -481,6 +473,7 @@ pub fn estimate_slopes(
             resumed = JointOptions {
                 region_water: Some(&broad),
                 starts_placed: true,
+                start_images: &start_images,
                 resume,
                 reweight: Some(Reweight { cache, target }),
                 ..common

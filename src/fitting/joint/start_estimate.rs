@@ -1,0 +1,180 @@
+//! The paper's estimate that starts a joint fit, made with few samples where the lamps'
+//! images pin its lights.
+//!
+//! A joint fit that reads the direct view starts each light whose lamp the photo shows whole
+//! on that lamp's image ([`super::place_starts`]), and the image pins every edge of it within
+//! a fraction of a pixel's footprint, whatever the start's noise. There the estimate only
+//! has to say which streaks are which lamp's: a noisier one, from fewer lobe samples a
+//! pixel, does that as well in a fraction of the time. Where a light it starts lies on no
+//! whole image (out of frame, hidden, cut by the frame) the reflections alone place it and
+//! every fit descends from the start, whose noise then moves the lights: the estimate is
+//! made again at the full samples.
+
+use super::direct_start::enclosing_image;
+use crate::fitting::rect::Rect;
+use crate::fitting::{FitOutcome, FittedLight};
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
+use crate::Result;
+
+/// Start lights placed on their lamps' whole direct images.
+pub struct PlacedStart {
+    /// The lights, as the caller's `place` put them.
+    pub lights: Vec<FittedLight>,
+    /// Where each light's lamp ends (its whole direct image's rectangle and a pixel's
+    /// footprint there), for the joint fits that start from them
+    /// ([`JointOptions::start_images`](super::JointOptions::start_images)).
+    pub images: Vec<Option<(Rect, f32)>>,
+}
+
+/// The estimate a joint fit starts from ([`start_estimate`]).
+pub struct StartEstimate {
+    /// The paper's estimate kept.
+    pub fit: FitOutcome,
+    /// Its lights as the caller's `place` put them, when the estimate with few samples was
+    /// kept; `None` when the estimate was made at the full samples (not placed yet).
+    pub placed: Option<PlacedStart>,
+    /// Lobe samples per traced pixel of the kept estimate.
+    pub samples: u32,
+}
+
+/// The paper's estimate `estimate(samples)`, first at `quick` samples when given and fewer
+/// than `full`: kept when `place` puts every light it starts on a lamp's whole direct image
+/// (module doc), else made again at `full`.
+pub fn start_estimate(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    quick: Option<u32>,
+    full: u32,
+    estimate: &dyn Fn(u32) -> Result<FitOutcome>,
+    place: &dyn Fn(&FitOutcome) -> Result<Vec<FittedLight>>,
+) -> Result<StartEstimate> {
+    if let Some(quick) = quick.filter(|&q| q < full) {
+        let fit = estimate(quick)?;
+        if !fit.lights.is_empty() {
+            let placed = place(&fit)?;
+            let images: Option<Vec<(Rect, f32)>> = placed
+                .iter()
+                .map(|light| enclosing_image(scene, photo, water, light))
+                .collect();
+            if let Some(images) = images {
+                return Ok(StartEstimate {
+                    fit,
+                    placed: Some(PlacedStart {
+                        lights: placed,
+                        images: images.into_iter().map(Some).collect(),
+                    }),
+                    samples: quick,
+                });
+            }
+        }
+    }
+    Ok(StartEstimate {
+        fit: estimate(full)?,
+        placed: None,
+        samples: full,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Mutex;
+
+    use super::*;
+    use crate::fitting::joint::place_starts;
+    use crate::fitting::{fit_paper, FitOptions};
+    use crate::progress::Reporter;
+
+    /// The samples each estimate was made with, and what `start_estimate` kept, on sample
+    /// photo `photo` with a first try at 32 and the full estimate at 128.
+    fn tries(photo: &str) -> (Vec<u32>, StartEstimate) {
+        let crate::samples::Fixture {
+            scene,
+            photo,
+            water,
+            observations,
+        } = crate::samples::fixture(photo);
+        let made = Mutex::new(Vec::new());
+        let estimate = |samples: u32| {
+            made.lock().unwrap().push(samples);
+            fit_paper(
+                scene,
+                photo,
+                water,
+                observations,
+                &FitOptions {
+                    samples,
+                    ..FitOptions::for_scene(scene)
+                },
+            )
+        };
+        let place = |fit: &FitOutcome| {
+            Ok(place_starts(
+                scene,
+                photo,
+                water,
+                observations,
+                &fit.lights,
+                Reporter::default(),
+            ))
+        };
+        let kept = start_estimate(scene, photo, water, Some(32), 128, &estimate, &place).unwrap();
+        (made.into_inner().unwrap(), kept)
+    }
+
+    /// Table 1's lamp is in the photo, whole: the estimate at 32 samples is kept, its light
+    /// placed on the lamp's image (within a footprint of it, so within a few of the truth).
+    #[test]
+    fn a_light_on_its_lamps_whole_image_keeps_the_quick_estimate() {
+        let (made, kept) = tries("table1.png");
+        assert_eq!(made, [32]);
+        assert_eq!(kept.samples, 32);
+        let placed = kept.placed.expect("placed");
+        assert_eq!(placed.lights.len(), 1);
+        assert_eq!(placed.images.len(), 1);
+        let (image, footprint) = placed.images[0].expect("the lamp's whole image");
+        // The true rectangle in the placed light's plane.
+        let (scene, plane) = (
+            &crate::samples::fixture("table1.png").scene,
+            &placed.lights[0].plane,
+        );
+        let light = crate::samples::table1_light();
+        let at = |x: f64, y: f64| {
+            plane.coords((glam::DVec3::new(x, y, light.corner.z) - scene.origin).as_vec3())
+        };
+        let (a, b) = (
+            at(light.corner.x, light.corner.y),
+            at(light.corner.x + light.width, light.corner.y + light.height),
+        );
+        let truth = Rect {
+            u_min: a.x.min(b.x),
+            u_max: a.x.max(b.x),
+            v_min: a.y.min(b.y),
+            v_max: a.y.max(b.y),
+        };
+        for (got, want) in [
+            (image.u_min, truth.u_min),
+            (image.u_max, truth.u_max),
+            (image.v_min, truth.v_min),
+            (image.v_max, truth.v_max),
+        ] {
+            assert!(
+                (got - want).abs() < 2.0 * footprint,
+                "image edge {got} against {want} (footprint {footprint})"
+            );
+        }
+    }
+
+    /// Table 3's second lamp is cut by the photo's right border: the reflections alone place
+    /// that light's far edge, so the estimate is made again at the full samples and not
+    /// placed.
+    #[test]
+    fn a_lamp_cut_by_the_frame_makes_the_estimate_again_in_full() {
+        let (made, kept) = tries("table3.png");
+        assert_eq!(made, [32, 128]);
+        assert_eq!(kept.samples, 128);
+        assert!(kept.placed.is_none());
+        assert_eq!(kept.fit.lights.len(), 2);
+    }
+}
