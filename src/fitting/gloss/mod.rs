@@ -122,8 +122,8 @@ pub(super) mod search;
 use std::time::Instant;
 
 use super::joint::{
-    fit_joint, place_starts, start_estimate, JointOptions, Lobe, ModelledPixel, PixelShare,
-    ProposalCache, Reweight, Split, StartEstimate, Uncertainty, DEFAULT_JOINT_SAMPLES,
+    fit_joint, start_estimate, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache,
+    Reweight, Split, StartEstimate, Uncertainty, DEFAULT_JOINT_SAMPLES,
 };
 use super::{fit_paper, FitOptions, FitOutcome, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
@@ -131,7 +131,7 @@ use crate::photo_in::Photo;
 use crate::scene_in::Scene;
 use crate::{Error, Result};
 use cost::{proposal, Cost, SearchFit};
-pub(super) use search::search_start;
+pub(super) use search::placed_search_start;
 use search::{search, Stop};
 
 /// How to search for the gloss. What the fits themselves read (samples, pixels, repeats,
@@ -332,14 +332,8 @@ pub fn estimate_gloss(
         direct_view: final_fit.direct_view,
         close_regions: final_fit.close_regions,
     };
-    // Every fit starts alike: the direct view places the starts once.
-    let place = |fit: &FitOutcome| -> Result<Vec<FittedLight>> {
-        let start = search_start(fit, streaks.len(), "gloss")?;
-        Ok(if final_fit.direct_view {
-            place_starts(scene, photo, water, streaks, &start, final_fit.progress)
-        } else {
-            start
-        })
+    let place = |fit: &FitOutcome| {
+        placed_search_start(scene, photo, water, streaks, fit, "gloss", final_fit)
     };
     let StartEstimate {
         fit: paper,

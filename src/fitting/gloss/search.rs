@@ -2,7 +2,10 @@
 //! by parabolas (the gloss module's doc, "Search" and "Uncertainty").
 
 use super::GlossSearch;
-use crate::fitting::{EdgeStatus, FittedLight, Skipped};
+use crate::fitting::joint::{place_starts, JointOptions};
+use crate::fitting::{EdgeStatus, FittedLight, Skipped, StreakObservation};
+use crate::photo_in::Photo;
+use crate::scene_in::Scene;
 use crate::{Error, Result};
 
 /// A point of the cost curve: `x = ln e`, its cost and residual variance.
@@ -237,6 +240,26 @@ fn parabola(p: &[Point; 3]) -> Option<(f64, f64)> {
     // S = a.s + d1 (x - a.x) + k (x - a.x)(x - b.x); dS/dx = 0 at:
     let v = 0.5 * (a.x + b.x) - d1 / (2.0 * k);
     v.is_finite().then_some((v, k))
+}
+
+/// [`search_start`] of the paper fit `paper` of `streaks`, placed on the lamps' direct
+/// images ([`place_starts`]) where `options` read the direct view: every fit of a search
+/// starts alike, so the direct view places the starts once.
+pub(in crate::fitting) fn placed_search_start(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    streaks: &[StreakObservation],
+    paper: &crate::fitting::FitOutcome,
+    what: &str,
+    options: &JointOptions,
+) -> Result<Vec<FittedLight>> {
+    let start = search_start(paper, streaks.len(), what)?;
+    Ok(if options.direct_view {
+        place_starts(scene, photo, water, streaks, &start, options.progress)
+    } else {
+        start
+    })
 }
 
 /// The start of a search over the water's lobe from the paper fit `paper` of `streaks`

@@ -208,6 +208,12 @@ pub(super) mod tests {
         Rect,
     ) {
         let (scene, photo, water, plane) = crate::fitting::joint::direct::tests::table1_wall();
+        let rect = table1_rect(scene, &plane);
+        (scene, photo, water, plane, rect)
+    }
+
+    /// Table 1's true light as a rectangle on `plane` (the wall's) of its sample scene.
+    pub(in crate::fitting::joint) fn table1_rect(scene: &Scene, plane: &LightPlane) -> Rect {
         let truth = crate::samples::table1_light();
         let at = |x: f64, y: f64| {
             plane.coords((glam::DVec3::new(x, y, truth.corner.z) - scene.origin).as_vec3())
@@ -216,13 +222,12 @@ pub(super) mod tests {
             at(truth.corner.x, truth.corner.y),
             at(truth.corner.x + truth.width, truth.corner.y + truth.height),
         );
-        let rect = Rect {
+        Rect {
             u_min: a.x.min(b.x),
             u_max: a.x.max(b.x),
             v_min: a.y.min(b.y),
             v_max: a.y.max(b.y),
-        };
-        (scene, photo, water, plane, rect)
+        }
     }
 
     /// Every edge of `got` within `footprint` (a pixel's, on the wall) of `truth`'s.

@@ -134,25 +134,9 @@ mod tests {
         assert_eq!(placed.lights.len(), 1);
         assert_eq!(placed.images.len(), 1);
         let (image, footprint) = placed.images[0].expect("the lamp's whole image");
-        // The true rectangle in the placed light's plane.
-        let (scene, plane) = (
-            &crate::samples::fixture("table1.png").scene,
-            &placed.lights[0].plane,
-        );
-        let light = crate::samples::table1_light();
-        let at = |x: f64, y: f64| {
-            plane.coords((glam::DVec3::new(x, y, light.corner.z) - scene.origin).as_vec3())
-        };
-        let (a, b) = (
-            at(light.corner.x, light.corner.y),
-            at(light.corner.x + light.width, light.corner.y + light.height),
-        );
-        let truth = Rect {
-            u_min: a.x.min(b.x),
-            u_max: a.x.max(b.x),
-            v_min: a.y.min(b.y),
-            v_max: a.y.max(b.y),
-        };
+        let scene = &crate::samples::fixture("table1.png").scene;
+        let truth =
+            crate::fitting::joint::direct_start::tests::table1_rect(scene, &placed.lights[0].plane);
         for (got, want) in [
             (image.u_min, truth.u_min),
             (image.u_max, truth.u_max),

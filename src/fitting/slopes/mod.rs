@@ -59,10 +59,10 @@ pub use uncertainty::{
 };
 
 use super::gloss::search::{search, Point, Stop};
-use super::gloss::{search_start, GlossSearch};
+use super::gloss::{placed_search_start, GlossSearch};
 use super::joint::{
-    fit_joint_with, place_starts, start_estimate, JointOptions, Lobe, PixelShare, ProposalCache,
-    Reweight, Split, StartEstimate, Uncertainty,
+    fit_joint_with, start_estimate, JointOptions, Lobe, PixelShare, ProposalCache, Reweight, Split,
+    StartEstimate, Uncertainty,
 };
 use super::{
     fit_paper_with, FitOptions, FitOutcome, FittedLight, Rect, Skipped, StreakObservation,
@@ -193,14 +193,8 @@ pub fn estimate_slopes(
             },
         )
     };
-    // The start lights of `fit`: every fit starts alike, so the direct view places them once.
-    let placed = |fit: &FitOutcome| -> Result<Vec<FittedLight>> {
-        let start = search_start(fit, streaks.len(), "waves' slope")?;
-        Ok(if final_fit.direct_view {
-            place_starts(scene, photo, water, streaks, &start, final_fit.progress)
-        } else {
-            start
-        })
+    let placed = |fit: &FitOutcome| {
+        placed_search_start(scene, photo, water, streaks, fit, "waves' slope", final_fit)
     };
     // Out of frame the reflections alone place the lights, every fit of the search descends
     // from the start, and a noisier start moves them (docs/decisions.md).
