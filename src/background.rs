@@ -125,7 +125,14 @@ pub fn estimate(photo: &Photo, water: &[bool], streak_pixels: &[u32]) -> Backgro
     // water to the horizon (the Fresnel factor), which one level per region would call
     // bright.
     let first = measure(photo, water, &streak, |i| typical[usize::from(!water[i])]);
-    let (pixels, cells_measured, cells) = measure(photo, water, &streak, |i| luminance(first.0[i]));
+    // A black night: the first measure is black, and so are both regions' typical pixels, so
+    // the second would compare against the same level (none) everywhere and measure the same.
+    let black = typical == [0.0; 2] && first.0.iter().all(|p| p.iter().all(|&c| c <= 0.0));
+    let (pixels, cells_measured, cells) = if black {
+        first
+    } else {
+        measure(photo, water, &streak, |i| luminance(first.0[i]))
+    };
     let water_count = water.iter().filter(|&&b| b).count().max(1);
     let mut water_mean = [0f64; 3];
     for (p, _) in pixels.iter().zip(water).filter(|(_, &on)| on) {

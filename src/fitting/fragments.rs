@@ -52,10 +52,7 @@ pub fn group(
         grouping.groups = streaks.iter().map(|s| (s.clone(), vec![s.id])).collect();
         return grouping;
     }
-    let coarse = FitOptions {
-        samples: (options.samples / 8).max(32),
-        ..*options
-    };
+    let coarse = coarse_options(options);
     let mut scratch = StageTimes::default();
     let mut fitted: Vec<(StreakObservation, FittedLight)> = Vec::new();
     for obs in streaks {
@@ -98,6 +95,15 @@ pub fn group(
         .map(|(obs, light)| ((obs, light.streak_ids.clone()), light))
         .unzip();
     grouping
+}
+
+/// The options of [`group`]'s coarse fits for a fit with `options`: an eighth of its samples,
+/// at least 32.
+pub fn coarse_options(options: &FitOptions) -> FitOptions {
+    FitOptions {
+        samples: (options.samples / 8).max(32),
+        ..*options
+    }
 }
 
 /// The streaks of each light `fit` fits from `streaks` (by their ids, sorted; in the order of

@@ -46,7 +46,7 @@ use crate::water_model::{ExactSurface, WaterModel};
 use crate::{Error, Result};
 
 /// How to fit.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitOptions {
     /// Lobe samples per traced pixel (camera-ray jitter and lobe direction drawn together, as
     /// the renderer does). The edge solutions average over tens of pixels, so a few hundred
@@ -335,65 +335,171 @@ pub fn fit_paper_with(
     streaks: &[StreakObservation],
     options: &FitOptions,
 ) -> Result<FitOutcome> {
-    check_sizes(photo, water)?;
-    let n = water.len();
-    if options.samples == 0 {
-        return Err(Error::Usage(
-            "the fit needs at least one sample per pixel".into(),
-        ));
-    }
-    for s in streaks {
-        let bad = s
-            .pixels
-            .iter()
-            .chain(s.edges.iter().flatten())
-            .chain(std::iter::once(&s.brightest))
-            .find(|&&p| p as usize >= n);
-        if let Some(p) = bad {
-            return Err(Error::Usage(format!(
-                "streak {} holds pixel index {p}, outside the {} x {} photo",
-                s.id, photo.width, photo.height
-            )));
+    PaperEstimates::new(water_model, scene, photo, water, streaks).fit(options)
+}
+
+/// The paper's estimates of one photo's streaks with several options (a first try at fewer
+/// samples, then the full estimate: [`joint::start_estimate`]): the fragments' grouping
+/// ([`fragments::group`]), which reads its own coarse options, is made once for every
+/// estimate whose coarse options are the same, and a group's coarse fit is its fit where
+/// those options are the estimate's own.
+pub struct PaperEstimates<'a> {
+    water_model: &'a dyn WaterModel,
+    scene: &'a Scene,
+    photo: &'a Photo,
+    water: &'a [bool],
+    streaks: &'a [StreakObservation],
+    /// The last grouping made, with the coarse options it was made with.
+    grouped: std::cell::RefCell<Option<(FitOptions, fragments::Grouping)>>,
+}
+
+impl<'a> PaperEstimates<'a> {
+    /// The estimates of `streaks` on `photo` (whose water covers `water`) over `water_model`.
+    pub fn new(
+        water_model: &'a dyn WaterModel,
+        scene: &'a Scene,
+        photo: &'a Photo,
+        water: &'a [bool],
+        streaks: &'a [StreakObservation],
+    ) -> Self {
+        PaperEstimates {
+            water_model,
+            scene,
+            photo,
+            water,
+            streaks,
+            grouped: std::cell::RefCell::new(None),
         }
     }
-    let mut times = single::StageTimes::default();
-    let t = Instant::now();
-    let fragments::Grouping {
-        groups,
-        mut skipped,
-        mut warnings,
-        ..
-    } = fragments::group(water_model, scene, photo, water, streaks, options);
-    let fragments_seconds = t.elapsed().as_secs_f64();
-    let mut lights = Vec::new();
-    for (obs, ids) in &groups {
-        match single::fit_streak(water_model, scene, photo, water, obs, options, &mut times) {
-            Ok(mut light) => {
-                light.streak_ids = ids.clone();
-                lights.push(light);
-            }
-            Err(s) => skipped.push(s),
-        }
-    }
-    for light in &lights {
-        if light.plane.hit_fraction < 0.5 {
-            warnings.push(format!(
-                "streak {:?}: only {:.0} % of the brightest pixel's reflected rays hit the light's \
-                 plane; the plane may be wrong",
-                light.streak_ids,
-                100.0 * light.plane.hit_fraction
+
+    /// The paper's estimate with `options` ([`fit_paper`]).
+    pub fn fit(&self, options: &FitOptions) -> Result<FitOutcome> {
+        let (water_model, scene, photo, water, streaks) = (
+            self.water_model,
+            self.scene,
+            self.photo,
+            self.water,
+            self.streaks,
+        );
+        check_sizes(photo, water)?;
+        let n = water.len();
+        if options.samples == 0 {
+            return Err(Error::Usage(
+                "the fit needs at least one sample per pixel".into(),
             ));
         }
+        for s in streaks {
+            let bad = s
+                .pixels
+                .iter()
+                .chain(s.edges.iter().flatten())
+                .chain(std::iter::once(&s.brightest))
+                .find(|&&p| p as usize >= n);
+            if let Some(p) = bad {
+                return Err(Error::Usage(format!(
+                    "streak {} holds pixel index {p}, outside the {} x {} photo",
+                    s.id, photo.width, photo.height
+                )));
+            }
+        }
+        let mut times = single::StageTimes::default();
+        let t = Instant::now();
+        let coarse = fragments::coarse_options(options);
+        let kept = self
+            .grouped
+            .borrow()
+            .as_ref()
+            .filter(|(made_with, _)| *made_with == coarse)
+            .map(|(_, grouping)| grouping.clone());
+        let grouping = kept.unwrap_or_else(|| {
+            let grouping = fragments::group(water_model, scene, photo, water, streaks, options);
+            *self.grouped.borrow_mut() = Some((coarse, grouping.clone()));
+            grouping
+        });
+        let fragments::Grouping {
+            groups,
+            mut skipped,
+            mut warnings,
+            coarse: coarse_fits,
+        } = grouping;
+        let fragments_seconds = t.elapsed().as_secs_f64();
+        // A group's coarse fit is the same fit where the coarse options are these.
+        let coarse_fits = if coarse == *options {
+            coarse_fits
+        } else {
+            Vec::new()
+        };
+        let mut lights = Vec::new();
+        for (k, (obs, ids)) in groups.iter().enumerate() {
+            let fit = match coarse_fits.get(k) {
+                Some(light) => Ok(light.clone()),
+                None => {
+                    single::fit_streak(water_model, scene, photo, water, obs, options, &mut times)
+                }
+            };
+            match fit {
+                Ok(mut light) => {
+                    light.streak_ids = ids.clone();
+                    lights.push(light);
+                }
+                Err(s) => skipped.push(s),
+            }
+        }
+        for light in &lights {
+            if light.plane.hit_fraction < 0.5 {
+                warnings.push(format!(
+                    "streak {:?}: only {:.0} % of the brightest pixel's reflected rays hit the \
+                     light's plane; the plane may be wrong",
+                    light.streak_ids,
+                    100.0 * light.plane.hit_fraction
+                ));
+            }
+        }
+        Ok(FitOutcome {
+            lights,
+            skipped,
+            warnings,
+            timings: vec![
+                ("plane".into(), times.plane),
+                ("footprints".into(), times.footprints),
+                ("solve".into(), times.solve),
+                ("fragments (coarse fit and merge)".into(), fragments_seconds),
+            ],
+        })
     }
-    Ok(FitOutcome {
-        lights,
-        skipped,
-        warnings,
-        timings: vec![
-            ("plane".into(), times.plane),
-            ("footprints".into(), times.footprints),
-            ("solve".into(), times.solve),
-            ("fragments (coarse fit and merge)".into(), fragments_seconds),
-        ],
-    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's estimate of Table 3's two streaks at 32 samples (the coarse fits' own) and
+    /// then at 128, from one [`PaperEstimates`] that groups once and reads its coarse fits,
+    /// gives the lights two separate estimates give, each grouping and fitting anew.
+    #[test]
+    fn estimates_that_share_a_grouping_are_the_estimates_made_apart() {
+        let crate::samples::Fixture {
+            scene,
+            photo,
+            water,
+            observations,
+        } = crate::samples::fixture("table3.png");
+        assert_eq!(observations.len(), 2);
+        let at = |samples| FitOptions {
+            samples,
+            ..FitOptions::for_scene(scene)
+        };
+        let shared = PaperEstimates::new(&ExactSurface, scene, photo, water, observations);
+        for samples in [32, 128] {
+            let kept = shared.fit(&at(samples)).unwrap();
+            let apart = fit_paper(scene, photo, water, observations, &at(samples)).unwrap();
+            assert_eq!(kept.lights.len(), 2);
+            assert_eq!(kept.lights, apart.lights, "at {samples} samples");
+            assert_eq!(kept.skipped, apart.skipped);
+        }
+        // At the coarse fits' own samples the estimate traced nothing past the grouping.
+        let again = shared.fit(&at(32)).unwrap();
+        let traced: f64 = again.timings[..3].iter().map(|(_, s)| s).sum();
+        assert_eq!(traced, 0.0, "{:?}", again.timings);
+    }
 }

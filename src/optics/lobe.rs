@@ -13,7 +13,7 @@ use super::shadowing::Shadowing;
 ///
 /// Fields are public for convenience; `gloss` must be finite and >= 0 and `ior` > 0 (the
 /// command line checks its inputs before building a model).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReflectionModel {
     /// The Blinn-Phong exponent `e` of the paper (光泽常数).
     pub gloss: f32,

@@ -357,17 +357,18 @@ impl Run<'_> {
             self.observations.len()
         ));
         let quick = j.filter(|j| j.direct_view).and(self.quick_exact_samples);
+        let estimates = fitting::PaperEstimates::new(
+            &ExactSurface,
+            self.scene,
+            self.photo,
+            self.water,
+            self.observations,
+        );
         let estimate = |samples: u32| {
-            fitting::fit_paper(
-                self.scene,
-                self.photo,
-                self.water,
-                self.observations,
-                &FitOptions {
-                    samples,
-                    ..self.paper
-                },
-            )
+            estimates.fit(&FitOptions {
+                samples,
+                ..self.paper
+            })
         };
         let place = |fit: &fitting::FitOutcome| {
             Ok(place_starts(
@@ -379,6 +380,7 @@ impl Run<'_> {
                 self.progress,
             ))
         };
+        let t = Instant::now();
         let StartEstimate {
             fit,
             placed,
@@ -395,7 +397,20 @@ impl Run<'_> {
         found.lights = fit.lights;
         found.skipped = fit.skipped;
         found.warnings.extend(fit.warnings);
+        // The stage's time besides the kept estimate's own: placing its lights, or the first
+        // estimate that was not kept.
+        let rest = t.elapsed().as_secs_f64() - fit.timings.iter().map(|(_, s)| s).sum::<f64>();
         found.timings = fit.timings;
+        if let Some(q) = quick.filter(|_| rest > 0.0) {
+            found.timings.push((
+                if placed.is_some() {
+                    "starts placed on the lamps' images".into()
+                } else {
+                    format!("a first estimate at {q} samples, not kept")
+                },
+                rest,
+            ));
+        }
         found.start_samples = samples;
         Ok(placed)
     }

@@ -125,10 +125,11 @@ use super::joint::{
     fit_joint, start_estimate, JointOptions, Lobe, ModelledPixel, PixelShare, ProposalCache,
     Reweight, Split, StartEstimate, Uncertainty, DEFAULT_JOINT_SAMPLES,
 };
-use super::{fit_paper, FitOptions, FitOutcome, FittedLight, Skipped, StreakObservation};
+use super::{FitOptions, FitOutcome, FittedLight, PaperEstimates, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::scene_in::Scene;
+use crate::water_model::ExactSurface;
 use crate::{Error, Result};
 use cost::{proposal, Cost, SearchFit};
 pub(super) use search::placed_search_start;
@@ -280,7 +281,7 @@ pub struct GlossEstimate {
 /// Estimates the water's gloss from the photo and fits the lights with it (see the module
 /// doc for the method).
 ///
-/// The inputs are those of [`fit_paper`]: the photo, its water mask and the streaks found in
+/// The inputs are those of [`fit_paper`](super::fit_paper): the photo, its water mask and the streaks found in
 /// it. `paper` is the paper fit that gives every candidate its start (its `model.gloss` is
 /// the first guess, the scene's typically; its seed is also the search's fits'), first made
 /// with `quick_samples` when given ([`start_estimate`]); `final_fit`
@@ -335,6 +336,7 @@ pub fn estimate_gloss(
     let place = |fit: &FitOutcome| {
         placed_search_start(scene, photo, water, streaks, fit, "gloss", final_fit)
     };
+    let estimates = PaperEstimates::new(&ExactSurface, scene, photo, water, streaks);
     let StartEstimate {
         fit: paper,
         placed,
@@ -346,16 +348,10 @@ pub fn estimate_gloss(
         quick_samples.filter(|_| final_fit.direct_view),
         start_options.samples,
         &|samples| {
-            fit_paper(
-                scene,
-                photo,
-                water,
-                streaks,
-                &FitOptions {
-                    samples,
-                    ..start_options
-                },
-            )
+            estimates.fit(&FitOptions {
+                samples,
+                ..start_options
+            })
         },
         &place,
     )?;

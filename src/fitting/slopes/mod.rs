@@ -65,7 +65,7 @@ use super::joint::{
     StartEstimate, Uncertainty,
 };
 use super::{
-    fit_paper_with, FitOptions, FitOutcome, FittedLight, Rect, Skipped, StreakObservation,
+    FitOptions, FitOutcome, FittedLight, PaperEstimates, Rect, Skipped, StreakObservation,
 };
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::photo_in::Photo;
@@ -179,19 +179,13 @@ pub fn estimate_slopes(
          search's start)",
         streaks.len()
     ));
+    let estimates = PaperEstimates::new(&start_water, scene, photo, water, streaks);
     let estimate = |samples: u32| {
-        fit_paper_with(
-            &start_water,
-            scene,
-            photo,
-            water,
-            streaks,
-            &FitOptions {
-                model,
-                samples,
-                ..*paper
-            },
-        )
+        estimates.fit(&FitOptions {
+            model,
+            samples,
+            ..*paper
+        })
     };
     let placed = |fit: &FitOutcome| {
         placed_search_start(scene, photo, water, streaks, fit, "waves' slope", final_fit)
