@@ -349,8 +349,9 @@ pub struct PaperEstimates<'a> {
     photo: &'a Photo,
     water: &'a [bool],
     streaks: &'a [StreakObservation],
-    /// The last grouping made, with the coarse options it was made with.
-    grouped: std::cell::RefCell<Option<(FitOptions, fragments::Grouping)>>,
+    /// The last grouping made, with the coarse options it was made with and the seconds it
+    /// took.
+    grouped: std::cell::RefCell<Option<(FitOptions, fragments::Grouping, f64)>>,
 }
 
 impl<'a> PaperEstimates<'a> {
@@ -403,18 +404,20 @@ impl<'a> PaperEstimates<'a> {
             }
         }
         let mut times = single::StageTimes::default();
-        let t = Instant::now();
         let coarse = fragments::coarse_options(options);
         let kept = self
             .grouped
             .borrow()
             .as_ref()
-            .filter(|(made_with, _)| *made_with == coarse)
-            .map(|(_, grouping)| grouping.clone());
-        let grouping = kept.unwrap_or_else(|| {
+            .filter(|(made_with, ..)| *made_with == coarse)
+            .map(|(_, grouping, seconds)| (grouping.clone(), *seconds));
+        // A grouping made for an earlier estimate counts the time it took then.
+        let (grouping, fragments_seconds) = kept.unwrap_or_else(|| {
+            let t = Instant::now();
             let grouping = fragments::group(water_model, scene, photo, water, streaks, options);
-            *self.grouped.borrow_mut() = Some((coarse, grouping.clone()));
-            grouping
+            let seconds = t.elapsed().as_secs_f64();
+            *self.grouped.borrow_mut() = Some((coarse, grouping.clone(), seconds));
+            (grouping, seconds)
         });
         let fragments::Grouping {
             groups,
@@ -422,7 +425,6 @@ impl<'a> PaperEstimates<'a> {
             mut warnings,
             coarse: coarse_fits,
         } = grouping;
-        let fragments_seconds = t.elapsed().as_secs_f64();
         // A group's coarse fit is the same fit where the coarse options are these.
         let coarse_fits = if coarse == *options {
             coarse_fits

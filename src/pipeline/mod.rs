@@ -397,8 +397,9 @@ impl Run<'_> {
         found.lights = fit.lights;
         found.skipped = fit.skipped;
         found.warnings.extend(fit.warnings);
-        // The stage's time besides the kept estimate's own: placing its lights, or the first
-        // estimate that was not kept.
+        // The stage's time besides the kept estimate's own (its grouping counted once, where
+        // both estimates shared it): placing its lights, or the first estimate that was not
+        // kept.
         let rest = t.elapsed().as_secs_f64() - fit.timings.iter().map(|(_, s)| s).sum::<f64>();
         found.timings = fit.timings;
         if let Some(q) = quick.filter(|_| rest > 0.0) {
