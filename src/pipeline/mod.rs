@@ -370,14 +370,14 @@ impl Run<'_> {
                 ..self.paper
             })
         };
-        let place = |fit: &fitting::FitOutcome| {
+        let place = |fit: &fitting::FitOutcome, progress: Reporter<'_>| {
             Ok(place_starts(
                 self.scene,
                 self.photo,
                 self.water,
                 self.observations,
                 &fit.lights,
-                self.progress,
+                progress,
             ))
         };
         let t = Instant::now();
@@ -393,6 +393,7 @@ impl Run<'_> {
             self.paper.samples,
             &estimate,
             &place,
+            self.progress,
         )?;
         found.lights = fit.lights;
         found.skipped = fit.skipped;

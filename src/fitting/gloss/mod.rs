@@ -128,6 +128,7 @@ use super::joint::{
 use super::{FitOptions, FitOutcome, FittedLight, PaperEstimates, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
+use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::water_model::ExactSurface;
 use crate::{Error, Result};
@@ -333,8 +334,9 @@ pub fn estimate_gloss(
         direct_view: final_fit.direct_view,
         close_regions: final_fit.close_regions,
     };
-    let place = |fit: &FitOutcome| {
-        placed_search_start(scene, photo, water, streaks, fit, "gloss", final_fit)
+    let place = |fit: &FitOutcome, progress: Reporter<'_>| {
+        let placing = final_fit.direct_view.then_some(progress);
+        placed_search_start(scene, photo, water, streaks, fit, "gloss", placing)
     };
     let estimates = PaperEstimates::new(&ExactSurface, scene, photo, water, streaks);
     let StartEstimate {
@@ -354,11 +356,12 @@ pub fn estimate_gloss(
             })
         },
         &place,
+        final_fit.progress,
     )?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
     let (start, start_images) = match placed {
         Some(p) => (p.lights, p.images),
-        None => (place(&paper)?, Vec::new()),
+        None => (place(&paper, final_fit.progress)?, Vec::new()),
     };
     let mut warnings = paper.warnings.clone();
 

@@ -2,9 +2,10 @@
 //! by parabolas (the gloss module's doc, "Search" and "Uncertainty").
 
 use super::GlossSearch;
-use crate::fitting::joint::{place_starts, JointOptions};
+use crate::fitting::joint::place_starts;
 use crate::fitting::{EdgeStatus, FittedLight, Skipped, StreakObservation};
 use crate::photo_in::Photo;
+use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::{Error, Result};
 
@@ -243,8 +244,9 @@ fn parabola(p: &[Point; 3]) -> Option<(f64, f64)> {
 }
 
 /// [`search_start`] of the paper fit `paper` of `streaks`, placed on the lamps' direct
-/// images ([`place_starts`]) where `options` read the direct view: every fit of a search
-/// starts alike, so the direct view places the starts once.
+/// images ([`place_starts`], which tells `placing` what it changes) where the fits read the
+/// direct view (`placing` given): every fit of a search starts alike, so the direct view
+/// places the starts once.
 pub(in crate::fitting) fn placed_search_start(
     scene: &Scene,
     photo: &Photo,
@@ -252,13 +254,12 @@ pub(in crate::fitting) fn placed_search_start(
     streaks: &[StreakObservation],
     paper: &crate::fitting::FitOutcome,
     what: &str,
-    options: &JointOptions,
+    placing: Option<Reporter<'_>>,
 ) -> Result<Vec<FittedLight>> {
     let start = search_start(paper, streaks.len(), what)?;
-    Ok(if options.direct_view {
-        place_starts(scene, photo, water, streaks, &start, options.progress)
-    } else {
-        start
+    Ok(match placing {
+        Some(progress) => place_starts(scene, photo, water, streaks, &start, progress),
+        None => start,
     })
 }
 

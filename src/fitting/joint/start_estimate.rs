@@ -10,10 +10,13 @@
 //! every fit descends from the start, whose noise then moves the lights: the estimate is
 //! made again at the full samples.
 
+use std::sync::Mutex;
+
 use super::direct_start::enclosing_image;
 use crate::fitting::rect::Rect;
 use crate::fitting::{FitOutcome, FittedLight};
 use crate::photo_in::Photo;
+use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::Result;
 
@@ -39,8 +42,11 @@ pub struct StartEstimate {
 }
 
 /// The paper's estimate `estimate(samples)`, first at `quick` samples when given and fewer
-/// than `full`: kept when `place` puts every light it starts on a lamp's whole direct image
-/// (module doc), else made again at `full`.
+/// than `full`: kept when `place` (telling the reporter it is given what it changes) puts
+/// every light it starts on a lamp's whole direct image (module doc), else made again at
+/// `full`. `progress` hears what placing the kept estimate changed, and nothing of an
+/// estimate not kept.
+#[allow(clippy::too_many_arguments)]
 pub fn start_estimate(
     scene: &Scene,
     photo: &Photo,
@@ -48,17 +54,27 @@ pub fn start_estimate(
     quick: Option<u32>,
     full: u32,
     estimate: &dyn Fn(u32) -> Result<FitOutcome>,
-    place: &dyn Fn(&FitOutcome) -> Result<Vec<FittedLight>>,
+    place: &dyn Fn(&FitOutcome, Reporter<'_>) -> Result<Vec<FittedLight>>,
+    progress: Reporter<'_>,
 ) -> Result<StartEstimate> {
     if let Some(quick) = quick.filter(|&q| q < full) {
         let fit = estimate(quick)?;
         if !fit.lights.is_empty() {
-            let placed = place(&fit)?;
+            let heard: Mutex<Vec<String>> = Mutex::new(Vec::new());
+            let hear = |line: &str| {
+                if let Ok(mut lines) = heard.lock() {
+                    lines.push(line.to_string());
+                }
+            };
+            let placed = place(&fit, Reporter::new(&hear))?;
             let images: Option<Vec<(Rect, f32)>> = placed
                 .iter()
                 .map(|light| enclosing_image(scene, photo, water, light))
                 .collect();
             if let Some(images) = images {
+                for line in heard.into_inner().unwrap_or_default() {
+                    progress.stage(&line);
+                }
                 return Ok(StartEstimate {
                     fit,
                     placed: Some(PlacedStart {
@@ -109,17 +125,27 @@ mod tests {
                 },
             )
         };
-        let place = |fit: &FitOutcome| {
+        let place = |fit: &FitOutcome, progress: Reporter<'_>| {
             Ok(place_starts(
                 scene,
                 photo,
                 water,
                 observations,
                 &fit.lights,
-                Reporter::default(),
+                progress,
             ))
         };
-        let kept = start_estimate(scene, photo, water, Some(32), 128, &estimate, &place).unwrap();
+        let kept = start_estimate(
+            scene,
+            photo,
+            water,
+            Some(32),
+            128,
+            &estimate,
+            &place,
+            Reporter::default(),
+        )
+        .unwrap();
         (made.into_inner().unwrap(), kept)
     }
 

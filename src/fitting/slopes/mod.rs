@@ -70,6 +70,7 @@ use super::{
 use crate::optics::{GaussianSlopes, ReflectionModel};
 use crate::photo_in::Photo;
 use crate::pixel_scale::scaled_pixels;
+use crate::progress::Reporter;
 use crate::scene_in::Scene;
 use crate::water_model::{MeanSurface, StatisticalSurface};
 use crate::Result;
@@ -187,8 +188,9 @@ pub fn estimate_slopes(
             ..*paper
         })
     };
-    let placed = |fit: &FitOutcome| {
-        placed_search_start(scene, photo, water, streaks, fit, "waves' slope", final_fit)
+    let placed = |fit: &FitOutcome, progress: Reporter<'_>| {
+        let placing = final_fit.direct_view.then_some(progress);
+        placed_search_start(scene, photo, water, streaks, fit, "waves' slope", placing)
     };
     // Out of frame the reflections alone place the lights, every fit of the search descends
     // from the start, and a noisier start moves them (docs/decisions.md).
@@ -204,6 +206,7 @@ pub fn estimate_slopes(
         paper.samples,
         &estimate,
         &placed,
+        final_fit.progress,
     )?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
     if paper_fit.lights.is_empty() {
@@ -230,7 +233,7 @@ pub fn estimate_slopes(
     }
     let (start, start_images) = match placed_start {
         Some(p) => (p.lights, p.images),
-        None => (placed(&paper_fit)?, Vec::new()),
+        None => (placed(&paper_fit, final_fit.progress)?, Vec::new()),
     };
     let mut warnings = paper_fit.warnings.clone();
     let broad = water_with_total(surface, start_variance.map(|v| (4.0 * v).min(hi)));
