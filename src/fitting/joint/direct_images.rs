@@ -15,6 +15,7 @@ use super::direct::image_box;
 use crate::fitting::light_plane::LightPlane;
 use crate::fitting::rect::Rect;
 use crate::photo_in::Photo;
+use crate::scene_in::BoxHits;
 use crate::scene_in::Scene;
 
 /// Fewest pixels a direct image must have to count.
@@ -45,6 +46,13 @@ pub(super) struct DirectImage {
 
 /// The direct images on `plane` inside `search` (module doc), each with `reach` its own
 /// rectangle.
+///
+/// Only the pixels that can matter are looked at (their camera rays' hits read or traced, and
+/// tested against the plane): those at least half as bright as the brightest the plane may
+/// hold, and their neighbours (whether an image is enclosed). A night photo's box around a
+/// light is mostly dark, and at 4000 x 3000, where the scene keeps no hits of the whole
+/// image, looking at all of it traced millions of rays a look. The images found are those a
+/// look at every pixel finds (the tests hold them equal).
 pub(super) fn images_in(
     scene: &Scene,
     photo: &Photo,
@@ -52,47 +60,219 @@ pub(super) fn images_in(
     plane: &LightPlane,
     search: Rect,
 ) -> Vec<DirectImage> {
+    images_looking_from(scene, photo, water, plane, search, None)
+}
+
+/// [`images_in`], looking first at the pixels at least `from` bright (`None`: half the
+/// brightest pixel off the water in the box; `Some(0.0)`: every pixel off the water).
+fn images_looking_from(
+    scene: &Scene,
+    photo: &Photo,
+    water: &[bool],
+    plane: &LightPlane,
+    search: Rect,
+    from: Option<f32>,
+) -> Vec<DirectImage> {
     let (w, h) = (photo.width, photo.height);
-    let Some((x0, y0, x1, y1)) = image_box(scene, &[plane], &[search], w, h) else {
+    let Some(area) = image_box(scene, &[plane], &[search], w, h) else {
         return Vec::new();
     };
-    // Per pixel of the box, row-major: its brightness where it sees the plane inside the
-    // search rectangle, else NaN. Traced row by row in parallel, the camera rays' hits from
-    // the scene's cache of them (`Scene::centre_hits`).
-    let origin = scene.camera.position;
-    let hits = scene.centre_hits((x0, y0, x1, y1), w, h, &|i| water[i]);
-    let hits = &hits;
+    let (x0, y0, x1, y1) = area;
     let (bw, bh) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
-    // Where pixel (x, y) sees the plane, if it does inside the search rectangle: plane
-    // coordinates and distance from the camera.
-    let on_plane = |x: u32, y: u32| -> Option<(Vec2, f32)> {
-        if water[photo.index(x, y)] {
-            return None;
-        }
-        let (triangle, t) = hits.get(x, y)?;
-        if !plane.contains_triangle(scene, triangle) {
-            return None;
-        }
-        let dir = scene.camera.direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
-        let q = plane.coords(origin + dir * t);
-        search.contains(q).then_some((q, t))
-    };
-    let value: Vec<f32> = (y0..=y1)
+    // Per pixel of the box, row-major, from the photo alone: its brightness off the water (a
+    // clipped pixel infinite), NaN on it.
+    let level: Vec<f32> = (y0..=y1)
         .into_par_iter()
         .flat_map_iter(|y| {
-            (x0..=x1).map(move |x| match on_plane(x, y) {
-                None => f32::NAN,
-                Some(_) => {
-                    let i = photo.index(x, y);
-                    if photo.clipped[i] {
-                        f32::INFINITY
-                    } else {
-                        photo.radiance[i].into_iter().fold(0.0f32, f32::max)
-                    }
+            (x0..=x1).map(move |x| {
+                let i = photo.index(x, y);
+                if water[i] {
+                    f32::NAN
+                } else if photo.clipped[i] {
+                    f32::INFINITY
+                } else {
+                    photo.radiance[i].into_iter().fold(0.0f32, f32::max)
                 }
             })
         })
         .collect();
+    let top = level
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f32, |a, &v| a.max(v));
+    let box_pixels = PixelArea {
+        area,
+        width: bw,
+        height: bh,
+    };
+    // A look from `from` tests every pixel at least that bright, and its neighbours. The
+    // images' threshold is half the brightest finite pixel on the plane, B (where the plane
+    // holds none, only the clipped pixels count). When the look finds B >= 2 from, no pixel
+    // it left out is brighter, and every pixel of B / 2 or more was tested: it is exact.
+    // Else a second look from its B / 2 is (or, where it found none, from zero: every
+    // pixel).
+    let first = from.unwrap_or(if top > 0.0 { 0.5 * top } else { f32::INFINITY });
+    let mut look = Look::new(
+        scene,
+        photo,
+        water,
+        plane,
+        search,
+        &box_pixels,
+        &level,
+        first,
+    );
+    let known = look.brightest();
+    let exact = if top <= 0.0 {
+        // No finite bright pixel off the water in the box: only clipped ones can be bright,
+        // and every one was looked at.
+        true
+    } else {
+        known > 0.0 && first <= 0.5 * known
+    };
+    if !exact {
+        let again = if known > 0.0 { 0.5 * known } else { 0.0 };
+        look = Look::new(
+            scene,
+            photo,
+            water,
+            plane,
+            search,
+            &box_pixels,
+            &level,
+            again,
+        );
+    }
+    images_of(scene, photo, &look, &box_pixels)
+}
+
+/// A box of pixels of the photo, inclusive, and its size.
+struct PixelArea {
+    area: (u32, u32, u32, u32),
+    width: usize,
+    height: usize,
+}
+
+/// The pixels of a box looked at: whether each sees `plane` inside the search rectangle.
+struct Look<'a> {
+    scene: &'a Scene,
+    photo: &'a Photo,
+    water: &'a [bool],
+    plane: &'a LightPlane,
+    search: Rect,
+    hits: BoxHits,
+    /// Per pixel of the box, row-major: its brightness (a clipped pixel infinite) where it was
+    /// looked at and sees the plane inside the search rectangle, else NaN.
+    value: Vec<f32>,
+}
+
+impl<'a> Look<'a> {
+    /// Looks at the pixels of `pixels` whose `level` is at least `from`, and at their
+    /// 8-neighbours off the water.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        scene: &'a Scene,
+        photo: &'a Photo,
+        water: &'a [bool],
+        plane: &'a LightPlane,
+        search: Rect,
+        pixels: &PixelArea,
+        level: &[f32],
+        from: f32,
+    ) -> Self {
+        let (x0, y0, x1, y1) = pixels.area;
+        let (bw, bh) = (pixels.width, pixels.height);
+        let seed: Vec<bool> = level.par_iter().map(|&v| v >= from).collect();
+        // The seeds and their 8-neighbours, off the water (NaN level).
+        let wanted: Vec<bool> = (0..bw * bh)
+            .into_par_iter()
+            .map(|b| {
+                if level[b].is_nan() {
+                    return false;
+                }
+                let (x, y) = ((b % bw) as i64, (b / bw) as i64);
+                (-1..=1i64).any(|dy| {
+                    (-1..=1i64).any(|dx| {
+                        let (nx, ny) = (x + dx, y + dy);
+                        nx >= 0
+                            && ny >= 0
+                            && (nx as usize) < bw
+                            && (ny as usize) < bh
+                            && seed[ny as usize * bw + nx as usize]
+                    })
+                })
+            })
+            .collect();
+        let w = photo.width as usize;
+        let wanted_ref = &wanted;
+        let skip = move |i: usize| {
+            let (x, y) = ((i % w) as u32, (i / w) as u32);
+            !wanted_ref[(y - y0) as usize * bw + (x - x0) as usize]
+        };
+        // The camera rays' hits, from the scene's cache of them (`Scene::centre_hits`).
+        let hits = scene.centre_hits(pixels.area, photo.width, photo.height, &skip);
+        let mut look = Look {
+            scene,
+            photo,
+            water,
+            plane,
+            search,
+            hits,
+            value: Vec::new(),
+        };
+        let look_ref = &look;
+        let value: Vec<f32> = (y0..=y1)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                (x0..=x1).map(move |x| {
+                    let b = (y - y0) as usize * bw + (x - x0) as usize;
+                    if !wanted_ref[b] || look_ref.on_plane(x, y).is_none() {
+                        f32::NAN
+                    } else {
+                        level[b]
+                    }
+                })
+            })
+            .collect();
+        look.value = value;
+        look
+    }
+
+    /// Where pixel (x, y) sees the plane, if it does inside the search rectangle: plane
+    /// coordinates and distance from the camera.
+    fn on_plane(&self, x: u32, y: u32) -> Option<(Vec2, f32)> {
+        let (w, h) = (self.photo.width, self.photo.height);
+        if self.water[self.photo.index(x, y)] {
+            return None;
+        }
+        let (triangle, t) = self.hits.get(x, y)?;
+        if !self.plane.contains_triangle(self.scene, triangle) {
+            return None;
+        }
+        let dir = self
+            .scene
+            .camera
+            .direction(x as f32 + 0.5, y as f32 + 0.5, w, h);
+        let q = self.plane.coords(self.scene.camera.position + dir * t);
+        self.search.contains(q).then_some((q, t))
+    }
+
+    /// The largest finite brightness of a pixel looked at that sees the plane (0 if none).
+    fn brightest(&self) -> f32 {
+        self.value
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f32, |a, &v| a.max(v))
+    }
+}
+
+/// The direct images a look holds: its bright pixels grouped (module doc).
+fn images_of(scene: &Scene, photo: &Photo, look: &Look, pixels: &PixelArea) -> Vec<DirectImage> {
+    let (w, h) = (photo.width, photo.height);
+    let (x0, y0, _, _) = pixels.area;
+    let (bw, bh) = (pixels.width, pixels.height);
+    let value = &look.value;
+    let on_plane = |x: u32, y: u32| look.on_plane(x, y);
     let brightest = value
         .iter()
         .filter(|v| v.is_finite())
@@ -109,7 +289,7 @@ pub(super) fn images_in(
     // The bright pixels, in the box's order: box index, image index, plane coordinates,
     // distance.
     let bright: Vec<(usize, usize, Vec2, f32)> = value
-        .iter()
+        .par_iter()
         .enumerate()
         .filter(|(_, v)| **v >= threshold)
         .filter_map(|(b, _)| {
@@ -164,7 +344,7 @@ pub(super) fn images_in(
             // the image) and how many of those are not surrounded: a side most of whose
             // pixels are not is cut (a corner pixel of a side the frame cuts lies on the
             // neighbouring side too).
-            let open: Vec<bool> = g.iter().map(|&m| !surrounded(m)).collect();
+            let open: Vec<bool> = g.par_iter().map(|&m| !surrounded(m)).collect();
             let mut along = [(0usize, 0usize); 4];
             for (&m, &open) in g.iter().zip(&open) {
                 let q = bright[m].2;
@@ -242,6 +422,71 @@ fn groups_8(pixels: &[usize], width: usize, height: usize) -> Vec<Vec<usize>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fitting::joint::direct_start::tests::table1;
+
+    /// What an image is, field by field, for comparing two looks.
+    fn key(im: &DirectImage) -> (usize, Rect, bool, [bool; 4], Rect, f32) {
+        (
+            im.first_pixel,
+            im.rect,
+            im.enclosed,
+            im.cut,
+            im.reach,
+            im.footprint,
+        )
+    }
+
+    fn keys(images: &[DirectImage]) -> Vec<(usize, Rect, bool, [bool; 4], Rect, f32)> {
+        images.iter().map(key).collect()
+    }
+
+    /// The look at the bright pixels alone finds the images a look at every pixel of the box
+    /// finds, to the bit: around Table 1's lamp with searches of several sizes (the box
+    /// reaching the frame's top and the water), and where the brightest pixel of the box lies
+    /// outside the search (a first look that is not enough, and a second).
+    #[test]
+    fn a_look_at_the_bright_pixels_finds_what_a_look_at_all_finds() {
+        let (scene, photo, water, plane, truth) = table1();
+        for grow in [0.05f32, 1.0, 3.0] {
+            let search = truth.grow(grow);
+            let lazy = images_in(scene, photo, water, &plane, search);
+            let full = images_looking_from(scene, photo, water, &plane, search, Some(0.0));
+            assert_eq!(lazy.len(), 1, "one lamp, searched {grow} m around it");
+            assert_eq!(keys(&lazy), keys(&full), "searched {grow} m around it");
+        }
+        // A pixel off the water, inside the search's box but outside the search (its box
+        // reaches a pixel past the rectangle's projection), made brighter than anything the
+        // lamp shows unclipped: the first look, from half of it, is not exact.
+        let search = truth.grow(0.3);
+        let (x0, y0, _, _) = image_box(scene, &[&plane], &[search], photo.width, photo.height)
+            .expect("the lamp's box");
+        let corner = photo.index(x0, y0);
+        assert!(!water[corner]);
+        let dir =
+            scene
+                .camera
+                .direction(x0 as f32 + 0.5, y0 as f32 + 0.5, photo.width, photo.height);
+        let q = plane.hit(scene.camera.position, dir).expect("the wall").1;
+        assert!(
+            !search.contains(q),
+            "the box's corner lies outside the search"
+        );
+        let lamp_brightest = (0..photo.radiance.len())
+            .filter(|&i| !water[i] && !photo.clipped[i])
+            .map(|i| photo.radiance[i].into_iter().fold(0.0f32, f32::max))
+            .fold(0.0f32, f32::max);
+        assert!(lamp_brightest > 0.0);
+        let mut bright = photo.clone();
+        bright.radiance[corner] = [4.0 * lamp_brightest; 3];
+        let lazy = images_in(scene, &bright, water, &plane, search);
+        let full = images_looking_from(scene, &bright, water, &plane, search, Some(0.0));
+        assert_eq!(lazy.len(), 1);
+        assert_eq!(keys(&lazy), keys(&full));
+        assert_eq!(
+            keys(&lazy),
+            keys(&images_in(scene, photo, water, &plane, search))
+        );
+    }
 
     #[test]
     fn groups_are_8_connected() {
