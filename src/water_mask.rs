@@ -7,25 +7,36 @@ use crate::scene_in::{Scene, KEPT_PIXELS};
 /// For each pixel of a `width` x `height` photo (row-major, row 0 at the top), true when the
 /// camera ray through the pixel centre first hits the water. An image the scene's cache of
 /// centre hits can hold whole is traced into it ([`Scene::centre_hits`]), and the lamps'
-/// direct images read the hits again; a larger one is traced row by row, without the
-/// 8 bytes a pixel the cache would take for a moment.
+/// direct images read the hits again; a larger one is traced row by row (in packets, as the
+/// cache is), without the 8 bytes a pixel the cache would take for a moment.
 pub fn water_mask(scene: &Scene, width: u32, height: u32) -> Vec<bool> {
     if width == 0 || height == 0 {
         return Vec::new();
     }
     let kept = (width as usize * height as usize <= KEPT_PIXELS)
         .then(|| scene.centre_hits((0, 0, width - 1, height - 1), width, height, &|_| false));
+    let is_water = |hit: Option<(u32, f32)>| {
+        hit.is_some_and(|(triangle, _)| scene.is_water[triangle as usize])
+    };
     let mut mask = vec![false; width as usize * height as usize];
     mask.par_chunks_mut(width as usize)
         .enumerate()
         .for_each(|(y, row)| {
-            for (x, cell) in row.iter_mut().enumerate() {
-                let (x, y) = (x as u32, y as u32);
-                let hit = match &kept {
-                    Some(hits) => hits.get(x, y),
-                    None => scene.centre_hit(x, y, width, height),
-                };
-                *cell = hit.is_some_and(|(triangle, _)| scene.is_water[triangle as usize]);
+            let y = y as u32;
+            match &kept {
+                Some(hits) => {
+                    for (x, cell) in row.iter_mut().enumerate() {
+                        *cell = is_water(hits.get(x as u32, y));
+                    }
+                }
+                None => {
+                    let mut cells = row.iter_mut();
+                    scene.centre_row(y, (0, width - 1), width, height, &|_| false, &mut |hit| {
+                        if let Some(cell) = cells.next() {
+                            *cell = is_water(hit.flatten());
+                        }
+                    });
+                }
             }
         });
     mask
@@ -62,5 +73,28 @@ mod tests {
         // The two directions agree to rounding: only a pixel whose ray grazes the water's
         // edge may flip.
         assert!(differ <= 5, "{differ} pixels differ");
+        // Every pixel of rows across the horizon and the water, traced in packets, as a
+        // single ray through its centre classifies it.
+        let origin = scene.camera.position;
+        let (mut on_water, mut off_water) = (0, 0);
+        for y in (0..3000u32).step_by(97) {
+            let row = &large[y as usize * 3000..(y as usize + 1) * 3000];
+            for (x, &got) in row.iter().enumerate() {
+                let dir = scene
+                    .camera
+                    .direction(x as f32 + 0.5, y as f32 + 0.5, 3000, 3000);
+                let want = scene
+                    .tracer
+                    .closest_hit(origin, dir, 0.0, f32::INFINITY)
+                    .is_some_and(|h| scene.is_water[h.triangle as usize]);
+                assert_eq!(got, want, "pixel ({x}, {y})");
+            }
+            on_water += row.iter().filter(|&&w| w).count();
+            off_water += row.iter().filter(|&&w| !w).count();
+        }
+        assert!(
+            on_water > 10_000 && off_water > 10_000,
+            "{on_water} water and {off_water} other pixels compared"
+        );
     }
 }

@@ -117,19 +117,60 @@ impl Scene {
         }
     }
 
-    /// The first hit (`Scene::tracer`) of the camera ray through the centre of pixel `(x, y)`
-    /// of a `width` x `height` image, traced now: the triangle and the distance.
-    pub fn centre_hit(&self, x: u32, y: u32, width: u32, height: u32) -> Option<(u32, f32)> {
-        let dir = self.centre_direction(x, y, width, height);
-        self.tracer
-            .closest_hit(self.camera.position, dir, 0.0, f32::INFINITY)
-            .map(|hit| (hit.triangle, hit.t))
-    }
-
     /// The direction of the camera ray through the centre of pixel (`x`, `y`).
     fn centre_direction(&self, x: u32, y: u32, width: u32, height: u32) -> glam::Vec3 {
         self.camera
             .direction(x as f32 + 0.5, y as f32 + 0.5, width, height)
+    }
+
+    /// The first hits of the camera rays through the centres of pixels `x0..=x1` of row `y`
+    /// of a `width` x `height` image, traced in packets of neighbours (which run close
+    /// together), given to `each` in order: `None` for a pixel `skip` leaves out, else the
+    /// first hit of `Scene::tracer` (the triangle and the distance, `None` for a miss), as a
+    /// single ray gets it, to the bit.
+    pub fn centre_row(
+        &self,
+        y: u32,
+        (x0, x1): (u32, u32),
+        width: u32,
+        height: u32,
+        skip: &dyn Fn(u32) -> bool,
+        each: &mut dyn FnMut(Option<Option<(u32, f32)>>),
+    ) {
+        let mut dirs = Vec::with_capacity(PACKET_RAYS);
+        let mut xs = Vec::with_capacity(PACKET_RAYS);
+        let mut found = [None; PACKET_RAYS];
+        let unlimited = [f32::INFINITY; PACKET_RAYS];
+        for first in (x0..=x1).step_by(PACKET_RAYS) {
+            let last = (first + PACKET_RAYS as u32 - 1).min(x1);
+            dirs.clear();
+            xs.clear();
+            for x in first..=last {
+                if !skip(x) {
+                    dirs.push(self.centre_direction(x, y, width, height));
+                    xs.push(x);
+                }
+            }
+            let found = &mut found[..dirs.len()];
+            self.tracer.closest_hits(
+                self.camera.position,
+                &dirs,
+                0.0,
+                &unlimited[..dirs.len()],
+                found,
+            );
+            let mut traced = xs.iter().zip(found.iter());
+            let mut next = traced.next();
+            for x in first..=last {
+                match next {
+                    Some((&tx, hit)) if tx == x => {
+                        next = traced.next();
+                        each(Some(hit.map(|h| (h.triangle, h.t))));
+                    }
+                    _ => each(None),
+                }
+            }
+        }
     }
 
     /// The first hit (`Scene::tracer`) of the camera ray through the centre of every pixel
@@ -175,50 +216,27 @@ impl Scene {
             // see the sky, and a long last task would leave the other cores idle.
             .with_max_len(2)
             .flat_map_iter(|y| {
-                // The row's centre rays in packets of neighbours, which run close together.
                 let mut row = Vec::with_capacity((x1 - x0 + 1) as usize);
-                let mut dirs = Vec::with_capacity(PACKET_RAYS);
-                let mut xs = Vec::with_capacity(PACKET_RAYS);
-                let mut found = [None; PACKET_RAYS];
-                for first in (x0..=x1).step_by(PACKET_RAYS) {
-                    let last = (first + PACKET_RAYS as u32 - 1).min(x1);
-                    dirs.clear();
-                    xs.clear();
-                    for x in first..=last {
-                        if !skip(index(x, y)) {
-                            dirs.push(self.centre_direction(x, y, width, height));
-                            xs.push(x);
-                        }
-                    }
-                    let found = &mut found[..dirs.len()];
-                    let unlimited = &[f32::INFINITY; PACKET_RAYS][..dirs.len()];
-                    self.tracer
-                        .closest_hits(self.camera.position, &dirs, 0.0, unlimited, found);
-                    let mut traced = xs.iter().zip(found.iter());
-                    let mut next = traced.next();
-                    for x in first..=last {
-                        let entry = match next {
-                            Some((&tx, hit)) if tx == x => {
-                                next = traced.next();
-                                match hit {
-                                    Some(hit) => Entry {
-                                        triangle: hit.triangle,
-                                        t: hit.t,
-                                    },
-                                    None => Entry {
-                                        triangle: MISS,
-                                        t: 0.0,
-                                    },
-                                }
-                            }
-                            _ => Entry {
+                self.centre_row(
+                    y,
+                    (x0, x1),
+                    width,
+                    height,
+                    &|x| skip(index(x, y)),
+                    &mut |hit| {
+                        row.push(match hit {
+                            None => Entry {
                                 triangle: SKIPPED,
                                 t: 0.0,
                             },
-                        };
-                        row.push(entry);
-                    }
-                }
+                            Some(None) => Entry {
+                                triangle: MISS,
+                                t: 0.0,
+                            },
+                            Some(Some((triangle, t))) => Entry { triangle, t },
+                        })
+                    },
+                );
                 row
             })
             .collect();
