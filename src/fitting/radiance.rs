@@ -33,9 +33,8 @@ pub fn bright_pixels(
     count: usize,
 ) -> Vec<u32> {
     let (w, h) = (photo.width, photo.height);
-    let mut member = std::collections::HashSet::with_capacity(obs.pixels.len());
-    member.extend(obs.pixels.iter().copied());
-    let usable = |q: u32| member.contains(&q) && water[q as usize] && !photo.clipped[q as usize];
+    let member = Membership::new(&obs.pixels, w);
+    let usable = |q: u32| member.contains(q) && water[q as usize] && !photo.clipped[q as usize];
     let box_ok = |p: u32| {
         (-1..=1).all(|dy| (-1..=1).all(|dx| neighbour(p, dx, dy, w, h).is_some_and(usable)))
     };
@@ -64,6 +63,66 @@ pub fn bright_pixels(
     scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     scored.truncate(count);
     scored.into_iter().map(|s| s.1).collect()
+}
+
+/// Which pixels of a `width`-wide image belong to a set: one flag per pixel of the set's
+/// bounding box (a streak of a large photo holds millions of pixels, each asked about nine
+/// times).
+struct Membership {
+    x0: u32,
+    y0: u32,
+    columns: u32,
+    rows: u32,
+    width: u32,
+    flags: Vec<bool>,
+}
+
+impl Membership {
+    fn new(pixels: &[u32], width: u32) -> Self {
+        let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+        for &p in pixels {
+            let (x, y) = (p % width, p / width);
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+        }
+        if pixels.is_empty() || width == 0 {
+            return Membership {
+                x0: 0,
+                y0: 0,
+                columns: 0,
+                rows: 0,
+                width,
+                flags: Vec::new(),
+            };
+        }
+        let (columns, rows) = (x1 - x0 + 1, y1 - y0 + 1);
+        let mut flags = vec![false; columns as usize * rows as usize];
+        for &p in pixels {
+            let (x, y) = (p % width - x0, p / width - y0);
+            flags[y as usize * columns as usize + x as usize] = true;
+        }
+        Membership {
+            x0,
+            y0,
+            columns,
+            rows,
+            width,
+            flags,
+        }
+    }
+
+    fn contains(&self, p: u32) -> bool {
+        if self.width == 0 {
+            return false;
+        }
+        let (x, y) = (p % self.width, p / self.width);
+        if x < self.x0 || y < self.y0 {
+            return false;
+        }
+        let (x, y) = (x - self.x0, y - self.y0);
+        x < self.columns
+            && y < self.rows
+            && self.flags[y as usize * self.columns as usize + x as usize]
+    }
 }
 
 /// Least-squares radiance per channel, `L_c = sum I_c c / sum c^2`, over `footprints` with the
@@ -102,4 +161,31 @@ pub fn observed_coefficient(pixel: [f32; 3], radiance: [f32; 3]) -> Option<f32> 
     }
     let il: f32 = pixel.iter().zip(&radiance).map(|(i, l)| i * l).sum();
     Some(il / ll)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::Rng;
+
+    /// Every pixel of an image, in the set's bounding box or not, is a member exactly when
+    /// the set holds it; an empty set holds nothing.
+    #[test]
+    fn membership_is_the_sets() {
+        let (w, h) = (37u32, 23u32);
+        let mut rng = Rng::new(3, 0);
+        let pixels: Vec<u32> = (0..w * h)
+            .filter(|&p| {
+                let (x, y) = (p % w, p / w);
+                (5..30).contains(&x) && (4..19).contains(&y) && rng.next_f32() < 0.4
+            })
+            .collect();
+        let set: std::collections::HashSet<u32> = pixels.iter().copied().collect();
+        let member = Membership::new(&pixels, w);
+        for p in 0..w * h + 50 {
+            assert_eq!(member.contains(p), set.contains(&p), "pixel {p}");
+        }
+        let none = Membership::new(&[], w);
+        assert!((0..w * h).all(|p| !none.contains(p)));
+    }
 }
