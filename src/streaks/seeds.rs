@@ -81,55 +81,70 @@ pub struct SeedPoint {
 
 /// The blurred V plane of the photo: max(R, G, B) of the Gaussian-blurred sRGB colours.
 pub fn value_plane(width: u32, height: u32, display: &[[f32; 3]], sigma: f32) -> Vec<f32> {
-    let v: Vec<f32> = display
-        .iter()
-        .map(|p| p[0].max(p[1]).max(p[2]).clamp(0.0, 1.0))
-        .collect();
     if sigma <= 0.0 {
-        return v;
+        return display
+            .par_iter()
+            .map(|p| p[0].max(p[1]).max(p[2]).clamp(0.0, 1.0))
+            .collect();
     }
     // The blur is applied to R, G and B before V is taken, as the paper blurs the RGB image;
     // blurring each channel separately keeps a red and a green neighbour from averaging to a
     // bright yellow.
     let mut channels: Vec<Vec<f32>> = (0..3)
-        .map(|c| display.iter().map(|p| p[c].clamp(0.0, 1.0)).collect())
+        .map(|c| display.par_iter().map(|p| p[c].clamp(0.0, 1.0)).collect())
         .collect();
     for ch in &mut channels {
         gaussian_blur(ch, width as usize, height as usize, sigma);
     }
-    (0..v.len())
-        .map(|i| channels[0][i].max(channels[1][i]).max(channels[2][i]))
+    let [r, g, b] = [&channels[0], &channels[1], &channels[2]];
+    (0..display.len())
+        .into_par_iter()
+        .map(|i| r[i].max(g[i]).max(b[i]))
         .collect()
 }
 
-/// A separable Gaussian blur with clamped borders, in place.
+/// A separable Gaussian blur with clamped borders, in place. Each pixel's sum is taken over
+/// the kernel's taps in order, from zero; a row at a time, each tap added to the whole row
+/// (which the processor does several pixels at once), in parallel over rows.
 fn gaussian_blur(plane: &mut [f32], w: usize, h: usize, sigma: f32) {
-    let radius = (3.0 * sigma).ceil() as i64;
-    let mut kernel: Vec<f32> = (-radius..=radius)
-        .map(|d| (-(d * d) as f32 / (2.0 * sigma * sigma)).exp())
+    if w == 0 || h == 0 {
+        return;
+    }
+    let radius = (3.0 * sigma).ceil() as usize;
+    let mut kernel: Vec<f32> = (0..=2 * radius)
+        .map(|j| {
+            let d = j as i64 - radius as i64;
+            (-(d * d) as f32 / (2.0 * sigma * sigma)).exp()
+        })
         .collect();
     let total: f32 = kernel.iter().sum();
     kernel.iter_mut().for_each(|k| *k /= total);
-    // Row by row in parallel, each pixel's sum in the same order as one pass would take it.
+    let clamped = |i: i64, n: usize| i.clamp(0, n as i64 - 1) as usize;
+    // Along the rows, each row read from a copy padded with its end pixels.
     let mut tmp = vec![0.0f32; plane.len()];
-    tmp.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for (j, k) in kernel.iter().enumerate() {
-                let xx = (x as i64 + j as i64 - radius).clamp(0, w as i64 - 1) as usize;
-                s += k * plane[y * w + xx];
+    tmp.par_chunks_mut(w).enumerate().for_each_init(
+        || vec![0.0f32; w + 2 * radius],
+        |padded, (y, out)| {
+            let row = &plane[y * w..(y + 1) * w];
+            for (i, p) in padded.iter_mut().enumerate() {
+                *p = row[clamped(i as i64 - radius as i64, w)];
             }
-            *out = s;
-        }
-    });
-    plane.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for (j, k) in kernel.iter().enumerate() {
-                let yy = (y as i64 + j as i64 - radius).clamp(0, h as i64 - 1) as usize;
-                s += k * tmp[yy * w + x];
+            out.fill(0.0);
+            for (j, &k) in kernel.iter().enumerate() {
+                for (o, &v) in out.iter_mut().zip(&padded[j..j + w]) {
+                    *o += k * v;
+                }
             }
-            *out = s;
+        },
+    );
+    // Along the columns: each tap a whole row of the first pass.
+    plane.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
+        out.fill(0.0);
+        for (j, &k) in kernel.iter().enumerate() {
+            let yy = clamped(y as i64 + j as i64 - radius as i64, h);
+            for (o, &v) in out.iter_mut().zip(&tmp[yy * w..(yy + 1) * w]) {
+                *o += k * v;
+            }
         }
     });
 }
@@ -250,6 +265,57 @@ mod tests {
         let pts = seed_points(row.len() as u32, 1, &row, &water, &params);
         let xs: Vec<u32> = pts.iter().map(|p| p.x).collect();
         assert_eq!(xs, vec![2, 7]);
+    }
+
+    /// Each pixel of the blur is the clamped-border convolution summed pixel by pixel, tap by
+    /// tap in order, to the bit: on images wider than tall, taller than wide and narrower
+    /// than the kernel.
+    #[test]
+    fn blur_is_the_per_pixel_convolution_to_the_bit() {
+        let reference = |plane: &[f32], w: usize, h: usize, sigma: f32| {
+            let radius = (3.0 * sigma).ceil() as i64;
+            let mut kernel: Vec<f32> = (-radius..=radius)
+                .map(|d| (-(d * d) as f32 / (2.0 * sigma * sigma)).exp())
+                .collect();
+            let total: f32 = kernel.iter().sum();
+            kernel.iter_mut().for_each(|k| *k /= total);
+            let at = |i: i64, n: usize| i.clamp(0, n as i64 - 1) as usize;
+            let mut tmp = vec![0.0f32; plane.len()];
+            for y in 0..h {
+                for x in 0..w {
+                    let mut s = 0.0;
+                    for (j, k) in kernel.iter().enumerate() {
+                        s += k * plane[y * w + at(x as i64 + j as i64 - radius, w)];
+                    }
+                    tmp[y * w + x] = s;
+                }
+            }
+            let mut out = vec![0.0f32; plane.len()];
+            for y in 0..h {
+                for x in 0..w {
+                    let mut s = 0.0;
+                    for (j, k) in kernel.iter().enumerate() {
+                        s += k * tmp[at(y as i64 + j as i64 - radius, h) * w + x];
+                    }
+                    out[y * w + x] = s;
+                }
+            }
+            out
+        };
+        let mut rng = crate::random::Rng::new(5, 0);
+        for (w, h, sigma) in [(41, 17, 1.5f32), (9, 30, 2.0), (5, 4, 3.0)] {
+            let plane: Vec<f32> = (0..w * h).map(|_| rng.next_f32()).collect();
+            let mut got = plane.clone();
+            gaussian_blur(&mut got, w, h, sigma);
+            let want = reference(&plane, w, h, sigma);
+            for (i, (g, r)) in got.iter().zip(&want).enumerate() {
+                assert_eq!(
+                    g.to_bits(),
+                    r.to_bits(),
+                    "{w} x {h}, sigma {sigma}: pixel {i}"
+                );
+            }
+        }
     }
 
     #[test]
