@@ -111,17 +111,20 @@ fn images_looking_from(
     // it left out is brighter, and every pixel of B / 2 or more was tested: it is exact.
     // Else a second look from its B / 2 is (or, where it found none, from zero: every
     // pixel).
+    let look_from = |from: f32| {
+        Look::new(
+            scene,
+            photo,
+            water,
+            plane,
+            search,
+            &box_pixels,
+            &level,
+            from,
+        )
+    };
     let first = from.unwrap_or(if top > 0.0 { 0.5 * top } else { f32::INFINITY });
-    let mut look = Look::new(
-        scene,
-        photo,
-        water,
-        plane,
-        search,
-        &box_pixels,
-        &level,
-        first,
-    );
+    let mut look = look_from(first);
     let known = look.brightest();
     let exact = if top <= 0.0 {
         // No finite bright pixel off the water in the box: only clipped ones can be bright,
@@ -132,16 +135,7 @@ fn images_looking_from(
     };
     if !exact {
         let again = if known > 0.0 { 0.5 * known } else { 0.0 };
-        look = Look::new(
-            scene,
-            photo,
-            water,
-            plane,
-            search,
-            &box_pixels,
-            &level,
-            again,
-        );
+        look = look_from(again);
     }
     images_of(scene, photo, &look, &box_pixels)
 }
