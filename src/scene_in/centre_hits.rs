@@ -3,11 +3,13 @@
 //! A fit looks for each lamp's direct image (`fitting::joint::direct_images`) several times:
 //! to place the start lights on the images, to give each lamp a light of its own, and to
 //! bound each light's region of interest; a statistical fit after an exact one does it all
-//! again. Each look traces the centre ray of every pixel of a box around the light, and the
-//! boxes mostly repeat or nest (on Table 1 the second and third boxes lie inside the first).
-//! At 4000 x 3000 a box holds millions of pixels and its trace took about 2 s a fit. The hits
-//! depend only on the scene's triangles, the camera and the image size, so a box traced once
-//! serves every later box inside it, hit for hit: the results are the same to the last bit.
+//! again. Each look reads the centre rays' hits of the pixels it tests in a box around the
+//! light (its bright pixels and their neighbours; every pixel where that is not enough), and
+//! the boxes mostly repeat or nest (on Table 1 the second and third boxes lie inside the
+//! first). The hits depend only on the scene's triangles, the camera and the image size, so
+//! a box traced once serves every later box inside it whose pixels it traced, hit for hit:
+//! the results are the same to the last bit. The pixels a box leaves out are marked so, and
+//! a later box that needs one of them is traced again.
 //! The water mask (`crate::water_mask`) traces the whole image this way first when it holds
 //! at most [`KEPT_PIXELS`], so every later box is read from its hits.
 //!
