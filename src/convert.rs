@@ -11,7 +11,7 @@ use crate::fitting::FittedLight;
 use crate::pipeline::{self, light_name, FitSettings, Input};
 use crate::progress::Reporter;
 use crate::report::{self, Files, Report};
-use crate::scene_in::{self, AreaLight, LoadOptions, Scene};
+use crate::scene_in::{self, LoadOptions, Scene};
 use crate::scene_out::{self, InputFiles, LightToWrite, WriteOptions};
 use crate::settings::{reword, Setting};
 use crate::{debug_pictures, output_file, Error, Result};
@@ -184,21 +184,6 @@ pub fn check_output(options: &ConvertOptions) -> Result<Vec<PathBuf>> {
     }
     output_file::ensure_distinct(&writes.iter().map(PathBuf::as_path).collect::<Vec<_>>())?;
     Ok(writes)
-}
-
-/// A fitted light as a renderable area light (scene frame).
-pub fn area_light(light: &FittedLight, name: String) -> AreaLight {
-    let c = light.rect().center();
-    let plane = &light.plane;
-    AreaLight {
-        name,
-        node: plane.node,
-        center: plane.point + plane.u * c.x + plane.v * c.y,
-        half_width: plane.u * (light.width() * 0.5),
-        half_height: plane.v * (light.height() * 0.5),
-        normal: plane.normal,
-        radiance: light.radiance,
-    }
 }
 
 fn light_to_write(scene: &Scene, light: &FittedLight, name: String) -> LightToWrite {

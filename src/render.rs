@@ -317,6 +317,59 @@ pub fn render_with_lights(
     options: &RenderOptions,
 ) -> Result<Rendered> {
     let (w, h) = (options.width, options.height);
+    let model = checked_model(scene, options)?;
+    let start = Instant::now();
+    let reflected = AtomicU64::new(0);
+    let rows_done = AtomicU64::new(0);
+    options.progress.advance(0, h as u64);
+    let mut pixels = vec![[0f32; 3]; w as usize * h as usize];
+    pixels
+        .par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let mut row_reflected = 0u64;
+            for (x, out) in row.iter_mut().enumerate() {
+                let (value, traced) =
+                    pixel_value(scene, lights, &model, options, x as u32, y as u32);
+                *out = value;
+                row_reflected += traced;
+            }
+            reflected.fetch_add(row_reflected, Ordering::Relaxed);
+            let done = rows_done.fetch_add(1, Ordering::Relaxed) + 1;
+            options.progress.advance(done, h as u64);
+        });
+    Ok(Rendered {
+        width: w,
+        height: h,
+        pixels,
+        camera_rays: w as u64 * h as u64 * camera_rays_per_pixel(options.samples_per_pixel) as u64,
+        reflected_rays: reflected.into_inner(),
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The pixels `pixels` (indices `y * width + x`) of [`render_with_lights`]'s image, each
+/// the same value to the last bit, rendered alone under the water's reflection model
+/// `model` (its gloss, index of refraction and shadowing, where the image's are the scene's
+/// material's and `options.shadowing`): what a test of a few pixels needs.
+pub fn render_pixels(
+    scene: &Scene,
+    lights: &[AreaLight],
+    model: &ReflectionModel,
+    options: &RenderOptions,
+    pixels: &[u32],
+) -> Result<Vec<[f32; 3]>> {
+    checked_model(scene, options)?;
+    let w = options.width;
+    Ok(pixels
+        .par_iter()
+        .map(|&p| pixel_value(scene, lights, model, options, p % w, p / w).0)
+        .collect())
+}
+
+/// The reflection model of `scene`'s water under `options`, once `options` are checked.
+fn checked_model(scene: &Scene, options: &RenderOptions) -> Result<ReflectionModel> {
+    let (w, h) = (options.width, options.height);
     if w == 0 || h == 0 || w > 32768 || h > 32768 {
         return Err(Error::Usage(format!(
             "the image size {w} x {h} is out of range (1 to 32768 on each side)"
@@ -331,87 +384,71 @@ pub fn render_with_lights(
             format!("must be a positive number, not {}", options.exposure),
         ));
     }
-    let model = ReflectionModel {
+    Ok(ReflectionModel {
         gloss: scene.water.gloss,
         ior: scene.water.ior,
         shadowing: options.shadowing,
-    };
-    let start = Instant::now();
-    let reflected = AtomicU64::new(0);
-    let rows_done = AtomicU64::new(0);
-    options.progress.advance(0, h as u64);
-    let mut pixels = vec![[0f32; 3]; w as usize * h as usize];
-    pixels
-        .par_chunks_mut(w as usize)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let mut row_reflected = 0u64;
-            let environment = options.environment.filter(|e| !e.is_black());
-            let camera_rays = camera_rays_per_pixel(options.samples_per_pixel);
-            let lobe_samples = options.samples_per_pixel / camera_rays;
-            let strata = (camera_rays as f32).sqrt() as u32;
-            for (x, out) in row.iter_mut().enumerate() {
-                let index = y as u64 * w as u64 + x as u64;
-                let mut rng = Rng::new(options.seed, index);
-                let sum = match environment.as_ref() {
-                    // Under a black night the pixel's camera rays go in packets.
-                    None => {
-                        let (sum, traced) = packets::black_night_pixel(
-                            scene,
-                            lights,
-                            &model,
-                            options.water,
-                            (x as u32, y as u32),
-                            (camera_rays, lobe_samples),
-                            (w, h),
-                            &mut rng,
-                        );
-                        row_reflected += traced;
-                        sum
-                    }
-                    Some(environment) => {
-                        let mut sum = [0f64; 3];
-                        for k in 0..camera_rays {
-                            let (value, traced) = pixel_sample(
-                                scene,
-                                lights,
-                                &model,
-                                options.water,
-                                Some(environment),
-                                PixelSample {
-                                    x: x as u32,
-                                    y: y as u32,
-                                    stratum: k,
-                                    strata,
-                                    lobe_samples,
-                                },
-                                w,
-                                h,
-                                &mut rng,
-                            );
-                            row_reflected += traced as u64;
-                            for c in 0..3 {
-                                sum[c] += value[c] as f64;
-                            }
-                        }
-                        sum
-                    }
-                };
-                let scale = options.exposure as f64 / camera_rays as f64;
-                *out = sum.map(|s| (s * scale) as f32);
-            }
-            reflected.fetch_add(row_reflected, Ordering::Relaxed);
-            let done = rows_done.fetch_add(1, Ordering::Relaxed) + 1;
-            options.progress.advance(done, h as u64);
-        });
-    Ok(Rendered {
-        width: w,
-        height: h,
-        pixels,
-        camera_rays: w as u64 * h as u64 * camera_rays_per_pixel(options.samples_per_pixel) as u64,
-        reflected_rays: reflected.into_inner(),
-        seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Pixel (x, y)'s value (radiance times exposure) and the reflected rays it traced, from its
+/// own random stream.
+fn pixel_value(
+    scene: &Scene,
+    lights: &[AreaLight],
+    model: &ReflectionModel,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+) -> ([f32; 3], u64) {
+    let (w, h) = (options.width, options.height);
+    let environment = options.environment.filter(|e| !e.is_black());
+    let camera_rays = camera_rays_per_pixel(options.samples_per_pixel);
+    let lobe_samples = options.samples_per_pixel / camera_rays;
+    let strata = (camera_rays as f32).sqrt() as u32;
+    let mut rng = Rng::new(options.seed, y as u64 * w as u64 + x as u64);
+    let (sum, traced) = match environment.as_ref() {
+        // Under a black night the pixel's camera rays go in packets.
+        None => packets::black_night_pixel(
+            scene,
+            lights,
+            model,
+            options.water,
+            (x, y),
+            (camera_rays, lobe_samples),
+            (w, h),
+            &mut rng,
+        ),
+        Some(environment) => {
+            let (mut sum, mut traced) = ([0f64; 3], 0u64);
+            for k in 0..camera_rays {
+                let (value, n) = pixel_sample(
+                    scene,
+                    lights,
+                    model,
+                    options.water,
+                    Some(environment),
+                    PixelSample {
+                        x,
+                        y,
+                        stratum: k,
+                        strata,
+                        lobe_samples,
+                    },
+                    w,
+                    h,
+                    &mut rng,
+                );
+                traced += n as u64;
+                for c in 0..3 {
+                    sum[c] += value[c] as f64;
+                }
+            }
+            (sum, traced)
+        }
+    };
+    let scale = options.exposure as f64 / camera_rays as f64;
+    (sum.map(|s| (s * scale) as f32), traced)
 }
 
 /// Lobe samples traced from each camera ray's water hit. Tracing the camera ray is as costly

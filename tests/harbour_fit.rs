@@ -141,8 +141,9 @@ fn the_photos_own_waves_keep_the_exact_model() {
     assert_pair(&scene, &lit);
 }
 
-/// Both lamps are in the photo, so the slope search's fits after its first hold them where
-/// that fit put them, and the final fit tries neither as two lights: each is one lamp's image.
+/// The exact model is tested at the paper's first estimate, on the streaks' pixels, and
+/// found unrelated to the photo there. Both lamps are in the photo, so the slope search's fits
+/// after its first hold them where that fit put them, and the final fit tries neither as two lights: each is one lamp's image.
 /// Every light of the start lies on its lamp's whole image, so the start is the paper's
 /// estimate at 128 lobe samples a pixel, not 512 (which out of frame it is:
 /// `tests/far_lights.rs`).
@@ -178,12 +179,22 @@ fn other_waves_take_the_statistical_model() {
         "{}",
         used.reason
     );
-    // So far from the photo already at the paper's lights that the exact fit is not made.
+    // So far from the photo already at the paper's first estimate of the lights (not kept:
+    // the exact model over other waves puts a light off its lamp's image) that neither the
+    // estimate at the full samples nor the exact joint fit is made.
     assert!(
-        used.reason.contains("the exact fit was not made"),
+        used.reason
+            .contains("neither the full estimate nor the exact fit was made"),
         "{}",
         used.reason
     );
+    let stage = |name: &str| lit.timings.iter().any(|(s, _)| s.contains(name));
+    assert!(
+        stage("the exact model tested at the first estimate"),
+        "{:?}",
+        lit.timings
+    );
+    assert!(!stage("fit: joint footprints"), "{:?}", lit.timings);
     assert!(used.slopes.as_ref().unwrap().estimated);
     assert_eq!(used.slopes.as_ref().unwrap().start_samples, 128);
     assert_pair(&scene, &lit);

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
 
-use crate::convert::{area_light, ConvertOptions};
+use crate::convert::ConvertOptions;
 use crate::optics::GaussianSlopes;
 use crate::output_file::write_atomically;
 use crate::photo_in::{linear_to_srgb, Photo};
@@ -253,7 +253,7 @@ fn fit_picture(
         .lights
         .iter()
         .enumerate()
-        .map(|(i, l)| area_light(l, light_name(i)))
+        .map(|(i, l)| l.area_light(light_name(i)))
         .collect();
     options.progress.stage(&format!(
         "debug pictures: the water re-rendered with the {} fitted light(s)",

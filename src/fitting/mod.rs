@@ -41,7 +41,7 @@ pub use threshold::threshold_streaks;
 
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
-use crate::scene_in::Scene;
+use crate::scene_in::{AreaLight, Scene};
 use crate::water_model::{ExactSurface, WaterModel};
 use crate::{Error, Result};
 
@@ -247,6 +247,21 @@ impl FittedLight {
             + self.plane.point.as_dvec3()
             + self.plane.u.as_dvec3() * u as f64
             + self.plane.v.as_dvec3() * v as f64
+    }
+
+    /// The light as a renderable area light named `name` (scene frame).
+    pub fn area_light(&self, name: String) -> AreaLight {
+        let c = self.rect().center();
+        let plane = &self.plane;
+        AreaLight {
+            name,
+            node: plane.node,
+            center: plane.point + plane.u * c.x + plane.v * c.y,
+            half_width: plane.u * (self.width() * 0.5),
+            half_height: plane.v * (self.height() * 0.5),
+            normal: plane.normal,
+            radiance: self.radiance,
+        }
     }
 
     /// The rectangle's centre in world coordinates.

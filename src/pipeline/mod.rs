@@ -10,6 +10,7 @@
 
 mod photo_check;
 mod settings;
+mod start;
 mod warnings;
 mod water_choice;
 mod water_fit;
@@ -20,17 +21,16 @@ pub use photo_check::{check_photo, ASPECT_TOLERANCE, MIN_PHOTO_SIDE};
 pub use settings::{FitSettings, GlossFit, JointSettings, Method, Reading, THOROUGH};
 pub use water_choice::{
     fine_structure, fine_structure_of, high_pass_radius, FineStructure, SlopesUsed, WaterChoice,
-    WaterModelUsed, EXACT_MIN_CORRELATION, EXACT_MIN_EXPLAINED, FLAT_SHARE, HIGH_PASS_RADIUS,
-    START_MAX_CORRELATION,
+    WaterModelUsed, EXACT_MIN_CORRELATION, EXACT_MIN_EXPLAINED, FIRST_ESTIMATE_TEST_SAMPLES,
+    FLAT_SHARE, HIGH_PASS_RADIUS, START_MAX_CORRELATION,
 };
 
 use crate::background::{self, Background};
 use crate::fitting::gloss::estimate_gloss;
 use crate::fitting::joint::{
-    fit_joint_with, place_starts, start_estimate, JointOptions, PixelShare, PlacedStart, Split,
-    StartEstimate, StartGate, Uncertainty,
+    fit_joint_with, JointOptions, PixelShare, PlacedStart, Split, StartGate, Uncertainty,
 };
-use crate::fitting::{self, FitOptions, FittedLight, Skipped, StreakObservation};
+use crate::fitting::{FitOptions, FittedLight, Skipped, StreakObservation};
 use crate::optics::ReflectionModel;
 use crate::photo_in::Photo;
 use crate::progress::Reporter;
@@ -229,6 +229,7 @@ pub fn fit(
         modelled: Vec::new(),
         splits: Vec::new(),
         stopped_at_start: false,
+        stopped_at_first_estimate: false,
         ended_at_split: false,
         share: None,
         start_samples: settings.paper_samples(false),
@@ -301,6 +302,9 @@ struct Found {
     /// Whether the last joint fit ended at its start (its start gate said so): no light,
     /// and `modelled` is the start lights' expected image.
     stopped_at_start: bool,
+    /// Whether that start was the paper's first estimate, not kept, and its expected image
+    /// had [`FIRST_ESTIMATE_TEST_SAMPLES`] lobe samples a pixel (`Run::paper`).
+    stopped_at_first_estimate: bool,
     /// Whether the last joint fit ended at its first split
     /// ([`JointOptions::end_at_split`]): no light yet, the overlap refit follows.
     ended_at_split: bool,
@@ -348,75 +352,6 @@ struct Run<'a> {
 }
 
 impl Run<'_> {
-    /// The paper's estimate (method §5 steps 7-9). Where it starts a joint fit `j` that reads
-    /// the direct view, it is first made with few samples ([`start_estimate`]); returns its
-    /// lights as placed on their lamps' images when that estimate was kept.
-    fn paper(&self, found: &mut Found, j: Option<&JointSettings>) -> Result<Option<PlacedStart>> {
-        self.progress.stage(&format!(
-            "fit of {} streak(s): the paper's estimate",
-            self.observations.len()
-        ));
-        let quick = j.filter(|j| j.direct_view).and(self.quick_exact_samples);
-        let estimates = fitting::PaperEstimates::new(
-            &ExactSurface,
-            self.scene,
-            self.photo,
-            self.water,
-            self.observations,
-        );
-        let estimate = |samples: u32| {
-            estimates.fit(&FitOptions {
-                samples,
-                ..self.paper
-            })
-        };
-        let place = |fit: &fitting::FitOutcome, progress: Reporter<'_>| {
-            Ok(place_starts(
-                self.scene,
-                self.photo,
-                self.water,
-                self.observations,
-                &fit.lights,
-                progress,
-            ))
-        };
-        let t = Instant::now();
-        let StartEstimate {
-            fit,
-            placed,
-            samples,
-        } = start_estimate(
-            self.scene,
-            self.photo,
-            self.water,
-            quick,
-            self.paper.samples,
-            &estimate,
-            &place,
-            self.progress,
-        )?;
-        found.lights = fit.lights;
-        found.skipped = fit.skipped;
-        found.warnings.extend(fit.warnings);
-        // The stage's time besides the kept estimate's own (its grouping counted once, where
-        // both estimates shared it): placing its lights, or the first estimate that was not
-        // kept.
-        let rest = t.elapsed().as_secs_f64() - fit.timings.iter().map(|(_, s)| s).sum::<f64>();
-        found.timings = fit.timings;
-        if let Some(q) = quick.filter(|_| rest > 0.0) {
-            found.timings.push((
-                if placed.is_some() {
-                    "starts placed on the lamps' images".into()
-                } else {
-                    format!("a first estimate at {q} samples, not kept")
-                },
-                rest,
-            ));
-        }
-        found.start_samples = samples;
-        Ok(placed)
-    }
-
     /// The joint fit's options for `reading`.
     fn joint_options(&self, j: &JointSettings, reading: Reading) -> JointOptions<'_> {
         JointOptions {

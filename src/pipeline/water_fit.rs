@@ -4,7 +4,7 @@
 
 use super::water_choice::{
     fine_structure_of, FineStructure, SlopesUsed, WaterChoice, WaterModelUsed, EXACT_MIN_EXPLAINED,
-    FLAT_SHARE, START_MAX_CORRELATION,
+    FIRST_ESTIMATE_TEST_SAMPLES, FLAT_SHARE, START_MAX_CORRELATION,
 };
 use super::{Found, GlossFit, Method, Run, EXACT_MIN_CORRELATION};
 use crate::fitting::gloss::GlossSearch;
@@ -62,7 +62,7 @@ impl Run<'_> {
         match (settings.water, &settings.method) {
             (WaterChoice::Statistical, method) => self.statistical(method, found, "forced", None),
             (WaterChoice::Exact, method) => {
-                self.exact(method, found, None)?;
+                self.exact(method, found, None, None)?;
                 // Measured all the same, for the report.
                 let fine = fine_structure_of(self.photo, self.scene.camera.yfov, &found.modelled);
                 Ok(WaterModelUsed {
@@ -73,7 +73,7 @@ impl Run<'_> {
             }
             // The paper's per-streak estimate has no expected image to compare.
             (WaterChoice::Auto, method @ Method::Paper) => {
-                self.exact(method, found, None)?;
+                self.exact(method, found, None, None)?;
                 Ok(WaterModelUsed {
                     chosen: "detected",
                     reason: "the paper's method has no expected image to compare with the \
@@ -100,7 +100,15 @@ impl Run<'_> {
                 let gate = |modelled: &[ModelledPixel]| {
                     !fine_structure_of(photo, yfov, modelled).is_some_and(|f| f.clearly_not_exact())
                 };
-                self.exact(method, found, Some(StartGate(&gate)))?;
+                // Where the paper's first estimate is not kept, the same test is made there
+                // first, on the streaks' pixels alone, before the estimate at the full samples
+                // and the joint fit's trace are made.
+                self.exact(
+                    method,
+                    found,
+                    Some(StartGate(&gate)),
+                    Some(StartGate(&gate)),
+                )?;
                 if found.lights.is_empty() && !found.stopped_at_start {
                     return Ok(WaterModelUsed {
                         chosen: "detected",
@@ -130,11 +138,21 @@ impl Run<'_> {
                 found.uncertainties.clear();
                 found.skipped.clear();
                 let at_start = found.stopped_at_start;
+                let at_first_estimate = found.stopped_at_first_estimate;
                 found.stopped_at_start = false;
+                found.stopped_at_first_estimate = false;
                 let mut used = self.statistical(method, found, "detected", correlation)?;
                 used.exact_explained = exact_explained;
                 used.reason = choice_reason(fine);
-                if at_start {
+                if at_first_estimate {
+                    used.reason.push_str(&format!(
+                        ", both measured at the paper's first estimate of the lights (its \
+                         expected image at {FIRST_ESTIMATE_TEST_SAMPLES} lobe samples a pixel), \
+                         already far from the exact model there (correlation under \
+                         {START_MAX_CORRELATION}): neither the full estimate nor the exact fit \
+                         was made"
+                    ));
+                } else if at_start {
                     used.reason.push_str(&format!(
                         ", both measured at the paper's estimate of the lights, already far \
                          from the exact model there (correlation under \
@@ -177,8 +195,16 @@ impl Run<'_> {
 
     /// The exact model's fit: the paper's estimate, the joint fit (the gloss estimated first
     /// when asked). `gate` may end the joint fit at its start ([`JointOptions::start_gate`]),
-    /// or the gloss search at its first fit.
-    fn exact(&self, method: &Method, found: &mut Found, gate: Option<StartGate<'_>>) -> Result<()> {
+    /// or the gloss search at its first fit; `first_test` the fit at a first estimate of the
+    /// paper's that is not kept, before the estimate is made again (`Run::paper`; not with
+    /// the gloss search).
+    fn exact(
+        &self,
+        method: &Method,
+        found: &mut Found,
+        gate: Option<StartGate<'_>>,
+        first_test: Option<StartGate<'_>>,
+    ) -> Result<()> {
         match method {
             Method::Joint(j) if matches!(j.gloss, GlossFit::Estimate(_)) => {
                 self.with_gloss_search(j, found, gate)
@@ -188,9 +214,9 @@ impl Run<'_> {
                     Method::Joint(j) => Some(j),
                     Method::Paper => None,
                 };
-                let placed = self.paper(found, joint)?;
+                let placed = self.paper(found, joint, first_test)?;
                 if let Some(j) = joint {
-                    if !found.lights.is_empty() {
+                    if !found.lights.is_empty() && !found.stopped_at_start {
                         self.refine(j, found, gate, placed)?;
                     }
                 }

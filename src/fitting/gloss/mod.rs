@@ -343,6 +343,7 @@ pub fn estimate_gloss(
         fit: paper,
         placed,
         samples: start_samples,
+        ..
     } = start_estimate(
         scene,
         photo,
@@ -356,6 +357,7 @@ pub fn estimate_gloss(
             })
         },
         &place,
+        None,
         final_fit.progress,
     )?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));

@@ -30,6 +30,10 @@ pub struct PlacedStart {
     pub images: Vec<Option<(Rect, f32)>>,
 }
 
+/// A caller's test of a first estimate not kept ([`start_estimate`]'s `unkept`): true ends
+/// the start there.
+pub type UnkeptTest<'a> = &'a dyn Fn(&FitOutcome) -> Result<bool>;
+
 /// The estimate a joint fit starts from ([`start_estimate`]).
 pub struct StartEstimate {
     /// The paper's estimate kept.
@@ -39,13 +43,19 @@ pub struct StartEstimate {
     pub placed: Option<PlacedStart>,
     /// Lobe samples per traced pixel of the kept estimate.
     pub samples: u32,
+    /// Whether the caller's test of the first estimate not kept (`unkept`) ended it there:
+    /// `fit` is that estimate, made at `samples`, and no estimate at the full samples was
+    /// made.
+    pub ended: bool,
 }
 
 /// The paper's estimate `estimate(samples)`, first at `quick` samples when given and fewer
 /// than `full`: kept when `place` (telling the reporter it is given what it changes) puts
 /// every light it starts on a lamp's whole direct image (module doc), else made again at
 /// `full`. `progress` hears what placing the kept estimate changed, and nothing of an
-/// estimate not kept.
+/// estimate not kept. `unkept`, when given, is asked about a first estimate with lights that
+/// is not kept, before the estimate at `full` is made: where it answers true, that estimate
+/// is returned as it is ([`StartEstimate::ended`]).
 #[allow(clippy::too_many_arguments)]
 pub fn start_estimate(
     scene: &Scene,
@@ -55,6 +65,7 @@ pub fn start_estimate(
     full: u32,
     estimate: &dyn Fn(u32) -> Result<FitOutcome>,
     place: &dyn Fn(&FitOutcome, Reporter<'_>) -> Result<Vec<FittedLight>>,
+    unkept: Option<UnkeptTest<'_>>,
     progress: Reporter<'_>,
 ) -> Result<StartEstimate> {
     if let Some(quick) = quick.filter(|&q| q < full) {
@@ -82,7 +93,18 @@ pub fn start_estimate(
                         images: images.into_iter().map(Some).collect(),
                     }),
                     samples: quick,
+                    ended: false,
                 });
+            }
+            if let Some(unkept) = unkept {
+                if unkept(&fit)? {
+                    return Ok(StartEstimate {
+                        fit,
+                        placed: None,
+                        samples: quick,
+                        ended: true,
+                    });
+                }
             }
         }
     }
@@ -90,6 +112,7 @@ pub fn start_estimate(
         fit: estimate(full)?,
         placed: None,
         samples: full,
+        ended: false,
     })
 }
 
@@ -143,6 +166,7 @@ mod tests {
             128,
             &estimate,
             &place,
+            None,
             Reporter::default(),
         )
         .unwrap();

@@ -198,6 +198,7 @@ pub fn estimate_slopes(
         fit: paper_fit,
         placed: placed_start,
         samples: start_samples,
+        ..
     } = start_estimate(
         scene,
         photo,
@@ -206,6 +207,7 @@ pub fn estimate_slopes(
         paper.samples,
         &estimate,
         &placed,
+        None,
         final_fit.progress,
     )?;
     timings.push(("paper fit".to_string(), t.elapsed().as_secs_f64()));
