@@ -303,7 +303,7 @@ struct Found {
     /// and `modelled` is the start lights' expected image.
     stopped_at_start: bool,
     /// Whether that start was the paper's first estimate, not kept, and its expected image
-    /// had [`FIRST_ESTIMATE_TEST_SAMPLES`] lobe samples a pixel (`Run::paper`).
+    /// had [`FIRST_ESTIMATE_TEST_SAMPLES`] samples a pixel over the streaks (`Run::paper`).
     stopped_at_first_estimate: bool,
     /// Whether the last joint fit ended at its first split
     /// ([`JointOptions::end_at_split`]): no light yet, the overlap refit follows.

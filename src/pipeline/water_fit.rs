@@ -147,8 +147,8 @@ impl Run<'_> {
                 if at_first_estimate {
                     used.reason.push_str(&format!(
                         ", both measured at the paper's first estimate of the lights (its \
-                         expected image at {FIRST_ESTIMATE_TEST_SAMPLES} lobe samples a pixel), \
-                         already far from the exact model there (correlation under \
+                         expected image of the streaks at {FIRST_ESTIMATE_TEST_SAMPLES} samples \
+                         a pixel), already far from the exact model there (correlation under \
                          {START_MAX_CORRELATION}): neither the full estimate nor the exact fit \
                          was made"
                     ));
