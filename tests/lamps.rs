@@ -52,6 +52,41 @@ fn an_orange_lamp_under_a_blue_one_gives_two_lights() {
     }
 }
 
+/// The orange and blue lamps over the flat quad a game scene holds (`scene-flat.gltf`): the
+/// statistical model's paper estimate starts one light for the streak, which its placing trims
+/// to the orange lamp's image; the blue lamp, above it, is looked for around the estimate's
+/// whole start, not the trimmed light alone, and starts a light of its own. Held: the
+/// statistical model, two lights, every edge within 1 % of the light's size and every
+/// radiance channel within 3 % (measured: 0.1 % and 1.1 %; before the lamps were looked for
+/// around the whole start the fit gave one light, its red 34 % low, and the slope search ran
+/// to its limits).
+#[test]
+fn an_orange_lamp_under_a_blue_one_over_a_flat_quad_gives_two_lights() {
+    let truths = samples::orange_and_blue_lights();
+    let dir = sample_scenes();
+    let report = convert(&ConvertOptions {
+        exposure: samples::PHOTO_EXPOSURE,
+        ..ConvertOptions::new(
+            dir.join("scene-flat.gltf"),
+            sample_photo_path("orange-blue.png"),
+            dir.join("orange-blue-flat-lamps-fit.gltf"),
+        )
+    })
+    .expect("fit")
+    .report;
+    assert_eq!(report.water_model.model, "statistical");
+    assert_eq!(report.lights.len(), 2, "{:?}", report.warnings);
+    assert!(
+        report.warnings.iter().all(|w| !w.contains("limit")),
+        "{:?}",
+        report.warnings
+    );
+    for truth in &truths {
+        let light = nearest(&report.lights, truth);
+        assert_light_within("over a flat quad", light, truth, 0.01, OfChannel(0.03));
+    }
+}
+
 /// The stacked sample (two white lamps 0.8 m apart, one streak), both lamps in the photo: at
 /// the defaults each light is pinned by its own lamp's image, so no refit over every pixel
 /// (the fit reads one water pixel of each 2 x 2 block, as where every lamp's image pins its

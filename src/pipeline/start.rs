@@ -23,9 +23,10 @@ impl Run<'_> {
     /// lights as placed on their lamps' images when that estimate was kept.
     ///
     /// `first_test`, given a joint fit `j`, is asked about the exact model's expected image
-    /// at a first estimate that is not kept ([`first_estimate_image`](Self::first_estimate_image)): where it says not to go on, the fit ends there as a joint fit
-    /// whose start gate said so ([`Found::stopped_at_start`]), and neither the estimate at
-    /// the full samples nor the joint fit is made.
+    /// at a first estimate that is not kept (`first_estimate_image`): where it says not to go
+    /// on, the fit ends there as a joint fit whose start gate said so
+    /// (`Found::stopped_at_start`), and neither the estimate at the full samples nor the
+    /// joint fit is made.
     pub(super) fn paper(
         &self,
         found: &mut Found,

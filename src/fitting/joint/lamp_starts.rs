@@ -15,8 +15,9 @@
 //! - a start over exactly two such images, each at least [`MIN_LAMP_SHARE`] of the box
 //!   around both, becomes two starts, one on each image, sharing its streaks (a lit sign's
 //!   letters, many small images, are left to one light);
-//! - an image near a light that no start overlaps starts a light of its own, sharing the
-//!   light's streaks, when it is the lamp of a reflection in them: its mirror image in the
+//! - an image near a light (or near the starts of its streaks, before they were trimmed to
+//!   a lamp's image) that no start overlaps starts a light of its own, sharing the light's
+//!   streaks, when it is the lamp of a reflection in them: its mirror image in the
 //!   water (mirrored in the horizontal plane of the water where the camera sees the streaks)
 //!   projects inside the streaks' bounding box in the image.
 //!
@@ -77,7 +78,7 @@ pub fn place_starts(
         ));
     }
     let before = on_images.len();
-    let placed = one_light_per_lamp(scene, photo, water, streaks, on_images);
+    let placed = one_light_per_lamp(scene, photo, water, streaks, on_images, start);
     if placed.len() > before {
         progress.stage(&format!(
             "joint fit: {} lamp(s) in the photo whose reflections share another light's streak \
@@ -88,18 +89,28 @@ pub fn place_starts(
     placed
 }
 
-/// The lights of `lights` split and added to one per lamp (module doc).
+/// The lights of `lights` split and added to one per lamp (module doc). `starts` are the
+/// lights `lights` were placed from ([`direct_starts`]): each light looks for lamps around
+/// the starts of its streaks as well as around itself, since a start trimmed to one lamp's
+/// image no longer reaches a lamp above or below it whose reflection shares its streak.
 pub(crate) fn one_light_per_lamp(
     scene: &Scene,
     photo: &Photo,
     water: &[bool],
     streaks: &[StreakObservation],
     lights: Vec<FittedLight>,
+    starts: &[FittedLight],
 ) -> Vec<FittedLight> {
     let near: Vec<Vec<DirectImage>> = lights
         .iter()
         .map(|light| {
-            let start = light.rect();
+            let start = starts
+                .iter()
+                .filter(|s| {
+                    s.plane.same_plane(&light.plane)
+                        && s.streak_ids.iter().any(|id| light.streak_ids.contains(id))
+                })
+                .fold(light.rect(), |r, s| r.union(&in_frame(s, &light.plane)));
             let search = start.grow(start.width().max(start.height()));
             images_in(scene, photo, water, &light.plane, search)
                 .into_iter()
