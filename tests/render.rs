@@ -61,64 +61,50 @@ fn pixels_rendered_alone_are_the_images() {
     };
     let scene = scene_with(0.3, "a.gltf");
     let (w, h) = (48u32, 40u32);
-    let night = render(
-        &scene,
-        &RenderOptions {
-            width: w,
-            height: h,
-            samples_per_pixel: 8,
-            seed: 5,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let brightest = (0..w * h)
-        .max_by(|&a, &b| night.pixels[a as usize][0].total_cmp(&night.pixels[b as usize][0]))
-        .unwrap();
-    let pixels: Vec<u32> = vec![w * h - 1, brightest, 0, 17, 5 * w + 3, 17, 30 * w + 40];
-    for environment in [
-        None,
-        Some(Environment {
-            sky: [0.3, 0.2, 0.1],
-            albedo: 0.4,
-        }),
-    ] {
-        let options = RenderOptions {
-            width: w,
-            height: h,
-            samples_per_pixel: 8,
-            seed: 5,
-            environment,
-            ..Default::default()
-        };
-        let image = render(&scene, &options).unwrap();
-        let model = ReflectionModel {
-            gloss: scene.water.gloss,
-            ior: scene.water.ior,
-            shadowing: options.shadowing,
-        };
-        let alone = render_pixels(&scene, &scene.area_lights, &model, &options, &pixels).unwrap();
-        let want: Vec<[f32; 3]> = pixels.iter().map(|&p| image.pixels[p as usize]).collect();
-        assert_eq!(alone, want, "environment {environment:?}");
-        assert!(want.iter().any(|p| p[0] > 0.0), "a lit pixel is asked for");
-    }
-    // Another gloss: the image of the scene whose material has it.
-    let rough = scene_with(0.6, "b.gltf");
-    let options = RenderOptions {
+    let options = |environment| RenderOptions {
         width: w,
         height: h,
         samples_per_pixel: 8,
         seed: 5,
+        environment,
         ..Default::default()
     };
-    let image = render(&rough, &options).unwrap();
-    let model = ReflectionModel {
-        gloss: rough.water.gloss,
-        ior: rough.water.ior,
-        shadowing: options.shadowing,
+    // The reflection model `render` takes from a scene's material.
+    let model_of = |s: &streaklight::scene_in::Scene| ReflectionModel {
+        gloss: s.water.gloss,
+        ior: s.water.ior,
+        shadowing: RenderOptions::default().shadowing,
     };
+    // `scene_from`'s image at `pixels` against `render_pixels` of `scene` under its model.
+    let check = |scene_from: &streaklight::scene_in::Scene, environment, pixels: &[u32]| {
+        let image = render(scene_from, &options(environment)).unwrap();
+        let alone = render_pixels(
+            &scene,
+            &scene.area_lights,
+            &model_of(scene_from),
+            &options(environment),
+            pixels,
+        )
+        .unwrap();
+        let want: Vec<[f32; 3]> = pixels.iter().map(|&p| image.pixels[p as usize]).collect();
+        assert_eq!(alone, want, "environment {environment:?}");
+        want
+    };
+    let night = render(&scene, &options(None)).unwrap();
+    let brightest = (0..w * h)
+        .max_by(|&a, &b| night.pixels[a as usize][0].total_cmp(&night.pixels[b as usize][0]))
+        .unwrap();
+    let pixels: Vec<u32> = vec![w * h - 1, brightest, 0, 17, 5 * w + 3, 17, 30 * w + 40];
+    let sky = Environment {
+        sky: [0.3, 0.2, 0.1],
+        albedo: 0.4,
+    };
+    for environment in [None, Some(sky)] {
+        let want = check(&scene, environment, &pixels);
+        assert!(want.iter().any(|p| p[0] > 0.0), "a lit pixel is asked for");
+    }
+    // Another gloss: the image of the scene whose material has it.
+    let rough = scene_with(0.6, "b.gltf");
     assert_ne!(rough.water.gloss, scene.water.gloss);
-    let alone = render_pixels(&scene, &scene.area_lights, &model, &options, &pixels).unwrap();
-    let want: Vec<[f32; 3]> = pixels.iter().map(|&p| image.pixels[p as usize]).collect();
-    assert_eq!(alone, want);
+    check(&rough, None, &pixels);
 }
