@@ -67,7 +67,7 @@ pub const START_MAX_CORRELATION: f64 = 0.15;
 /// over half the streaks' pixels alone and tested as the joint fit's start is
 /// ([`FineStructure::clearly_not_exact`]) before the estimate is made again at the full
 /// samples. Measured on the samples (docs/decisions.md): 0.35-0.76 for photos of the scene's
-/// own waves, -0.06 to 0.01 over other waves.
+/// own waves, -0.06 to 0.04 over other waves.
 pub const FIRST_ESTIMATE_TEST_SAMPLES: u32 = 8;
 
 /// The share of the material's slope variance under which the water mesh's own slope
