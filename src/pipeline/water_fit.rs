@@ -62,7 +62,7 @@ impl Run<'_> {
         match (settings.water, &settings.method) {
             (WaterChoice::Statistical, method) => self.statistical(method, found, "forced", None),
             (WaterChoice::Exact, method) => {
-                self.exact(method, found, None, None)?;
+                self.exact(method, found, None)?;
                 // Measured all the same, for the report.
                 let fine = fine_structure_of(self.photo, self.scene.camera.yfov, &found.modelled);
                 Ok(WaterModelUsed {
@@ -73,7 +73,7 @@ impl Run<'_> {
             }
             // The paper's per-streak estimate has no expected image to compare.
             (WaterChoice::Auto, method @ Method::Paper) => {
-                self.exact(method, found, None, None)?;
+                self.exact(method, found, None)?;
                 Ok(WaterModelUsed {
                     chosen: "detected",
                     reason: "the paper's method has no expected image to compare with the \
@@ -102,13 +102,8 @@ impl Run<'_> {
                 };
                 // Where the paper's first estimate is not kept, the same test is made there
                 // first, on the streaks' pixels alone, before the estimate at the full samples
-                // and the joint fit's trace are made.
-                self.exact(
-                    method,
-                    found,
-                    Some(StartGate(&gate)),
-                    Some(StartGate(&gate)),
-                )?;
+                // and the joint fit's trace are made (`Run::paper`).
+                self.exact(method, found, Some(StartGate(&gate)))?;
                 if found.lights.is_empty() && !found.stopped_at_start {
                     return Ok(WaterModelUsed {
                         chosen: "detected",
@@ -195,16 +190,10 @@ impl Run<'_> {
 
     /// The exact model's fit: the paper's estimate, the joint fit (the gloss estimated first
     /// when asked). `gate` may end the joint fit at its start ([`JointOptions::start_gate`]),
-    /// or the gloss search at its first fit; `first_test` the fit at a first estimate of the
-    /// paper's that is not kept, before the estimate is made again (`Run::paper`; not with
-    /// the gloss search).
-    fn exact(
-        &self,
-        method: &Method,
-        found: &mut Found,
-        gate: Option<StartGate<'_>>,
-        first_test: Option<StartGate<'_>>,
-    ) -> Result<()> {
+    /// or the gloss search at its first fit; without the gloss search, it is asked first at a
+    /// first estimate of the paper's that is not kept, before the estimate is made again
+    /// (`Run::paper`).
+    fn exact(&self, method: &Method, found: &mut Found, gate: Option<StartGate<'_>>) -> Result<()> {
         match method {
             Method::Joint(j) if matches!(j.gloss, GlossFit::Estimate(_)) => {
                 self.with_gloss_search(j, found, gate)
@@ -214,7 +203,7 @@ impl Run<'_> {
                     Method::Joint(j) => Some(j),
                     Method::Paper => None,
                 };
-                let placed = self.paper(found, joint, first_test)?;
+                let placed = self.paper(found, joint, gate)?;
                 if let Some(j) = joint {
                     if !found.lights.is_empty() && !found.stopped_at_start {
                         self.refine(j, found, gate, placed)?;
