@@ -297,6 +297,7 @@ impl Run<'_> {
                     model,
                     stacked_as_one: true,
                     glitter_weights: true,
+                    edges_by_image: true,
                     close_regions: false,
                     ..self.joint_options(j, j.reading)
                 };

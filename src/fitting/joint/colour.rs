@@ -194,6 +194,7 @@ mod tests {
             inv_samples: 1.0,
             first_direct: n,
             encoding: (crate::photo_rounding::Rounding::Float, 1.0),
+            edges_by_image: false,
         };
         let coef1: Vec<f32> = (0..n).map(|i| ((a[i] + b[i]) / 2.0) as f32).collect();
         let dev1: Vec<f32> = (0..n).map(|i| ((a[i] - b[i]) / 2.0) as f32).collect();

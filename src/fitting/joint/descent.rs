@@ -43,6 +43,12 @@ const IMAGE_FIRST_WINDOW: f32 = 2.0 * 1.732_050_8;
 /// ([`Problem::descend_near`]), in the same units: half a bound, about 0.3 of a footprint.
 const NEAR_FIRST_WINDOW: f32 = 0.5;
 
+/// Fewest direct pixels that must measure an edge (moved by it in a channel that is neither
+/// clipped nor black and in which the light shines) for them alone to place it
+/// ([`super::JointOptions::edges_by_image`]); as many as the uncertainties ask of them to
+/// count.
+const MIN_MEASURING: usize = super::uncertainty::MIN_DIRECT_PIXELS;
+
 /// The least first window, as a share of the light's distance from the camera: 0.5 m at the
 /// harbour's 40 m (at the paper's 10 m, 12.5 cm: no light of its samples is that small).
 const FIRST_WINDOW_SHARE: f32 = 0.0125;
@@ -128,9 +134,20 @@ impl Problem {
             })
             .collect();
         let least: Vec<f32> = st.rects.iter().map(min_window).collect();
+        let by_image: Vec<[bool; 4]> = (0..st.rects.len())
+            .map(|k| {
+                let seen = self.edges_by_image
+                    && self.sees_radiance(st.set_of[k], &st.rects[k], st.radiance[k]);
+                EdgeSide::ALL.map(|side| {
+                    seen && bounds[k][side].is_some()
+                        && self.measuring_direct_pixels(st, k, side) >= MIN_MEASURING
+                })
+            })
+            .collect();
         Windows {
             half: windows,
             least,
+            by_image,
             sweeps: 0,
         }
     }
@@ -150,6 +167,7 @@ impl Problem {
         let Windows {
             half: windows,
             least: min_windows,
+            by_image,
             sweeps: done,
         } = w;
         let grid = GRID;
@@ -181,7 +199,11 @@ impl Problem {
                         continue;
                     }
                     let step = (b - a) / (grid - 1) as f32;
-                    let prof = self.edge_profile(st, k, side, a, step, grid);
+                    let prof = if by_image[k][side] {
+                        self.edge_profile_by_image(st, k, side, a, step, grid)
+                    } else {
+                        self.edge_profile(st, k, side, a, step, grid)
+                    };
                     let cur_j = ((cur - a) / step).round().clamp(0.0, (grid - 1) as f32) as usize;
                     // Prefer the current position on ties (flat cost: an unconstrained edge).
                     let mut best = cur_j;
@@ -231,6 +253,11 @@ pub(super) struct Windows {
     half: Vec<[f32; 4]>,
     /// Per light, the least half-window ([`min_window`]).
     least: Vec<f32>,
+    /// Per light and edge, whether the edge is placed by the direct pixels alone
+    /// ([`super::JointOptions::edges_by_image`]): the photo shows the light's radiance
+    /// ([`Problem::sees_radiance`]), its direct image pins the edge
+    /// ([`Problem::image_bounds`]) and at least [`MIN_MEASURING`] of its pixels measure it.
+    by_image: Vec<[bool; 4]>,
     /// Sweeps made.
     sweeps: u32,
 }

@@ -129,6 +129,7 @@ impl Table3Light0 {
             inv_samples,
             first_direct: n,
             encoding: (crate::photo_rounding::Rounding::Float, 1.0),
+            edges_by_image: false,
         }
     }
 }

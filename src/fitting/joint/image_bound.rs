@@ -57,6 +57,30 @@ impl Problem {
         (refused(e + footprint) && refused(e - footprint)).then(|| footprint / 3f32.sqrt())
     }
 
+    /// The direct pixels that measure edge `side` of light k: moved by it (over a quarter of
+    /// a pixel's footprint either way, [`Problem::direct_step`]) in a channel that measures
+    /// the model ([`Problem::measures`]) and in which the light shines. 0 without direct
+    /// pixels or for a held edge.
+    pub(super) fn measuring_direct_pixels(&self, st: &State, k: usize, side: EdgeSide) -> usize {
+        let set = st.set_of[k];
+        let Some(h) = self.direct_step(set, side.along_u()) else {
+            return 0;
+        };
+        if st.pinned[k][side] {
+            return 0;
+        }
+        let r = st.rects[k];
+        let e = r.edge(side);
+        let (plus, minus) = (r.with_edge(side, e + h), r.with_edge(side, e - h));
+        let strip = minus.changed_strip(&plus);
+        (self.first_direct..self.n())
+            .filter(|&i| {
+                self.pixel_change(set, i, &minus, &plus, strip).0 != 0.0
+                    && (0..3).any(|ch| self.measures(i, ch) && st.radiance[k][ch] > 0.0)
+            })
+            .count()
+    }
+
     /// How much more the direct pixels disagree with the photo (their share of the cost's
     /// squares, with its clipped bounds) with light k at `moved`, every radiance held.
     fn direct_disagreement(&self, st: &State, k: usize, moved: &crate::fitting::Rect) -> f64 {

@@ -306,6 +306,7 @@ pub fn fit_joint_with(
             inv_samples: 1.0 / per_pixel_samples as f32,
             first_direct,
             encoding: (photo.rounding, photo.exposure),
+            edges_by_image: options.edges_by_image,
         }
     };
     // Rows weighted from the start by a fit before over the same pixels (`row_scales`).

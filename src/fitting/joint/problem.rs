@@ -34,6 +34,9 @@ pub(super) struct Problem {
     /// How the photo rounded its values, and its exposure: the rounding a lamp's image seen
     /// whole shares ([`Problem::shared_rounding`]).
     pub(super) encoding: (Rounding, f32),
+    /// Place the edges a light's direct image pins and measures by the direct pixels alone,
+    /// for a light whose radiance the photo shows ([`super::JointOptions::edges_by_image`]).
+    pub(super) edges_by_image: bool,
 }
 
 /// The state of a fit: every light's rectangle and radiance, and the coefficients they give.

@@ -205,6 +205,7 @@ mod tests {
             inv_samples: 1.0,
             first_direct: n,
             encoding: (crate::photo_rounding::Rounding::Float, 1.0),
+            edges_by_image: false,
         };
         let st = State {
             set_of: vec![0; lights],

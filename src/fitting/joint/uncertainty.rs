@@ -376,7 +376,7 @@ pub(super) fn uncertainties(
 
 /// Fewest direct pixels that must measure an edge (not clipped, not black, moved by it) for
 /// them to count in its uncertainty (see [`uncertainties`]).
-const MIN_DIRECT_PIXELS: usize = 16;
+pub(super) const MIN_DIRECT_PIXELS: usize = 16;
 
 /// Why an edge that faces another light split from the same start is reported unconstrained.
 pub(super) const FACING_REASON: &str =

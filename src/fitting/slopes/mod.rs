@@ -250,6 +250,7 @@ pub fn estimate_slopes(
         stacked_as_one: final_fit.stacked_as_one,
         direct_view: final_fit.direct_view,
         close_regions: final_fit.close_regions,
+        edges_by_image: final_fit.edges_by_image,
         // The final fit's share, so that its residual's correlation area, counted over the
         // pixels it read, grows the curvature of fits over the same share.
         pixels: final_fit.pixels,
