@@ -199,11 +199,12 @@ impl Problem {
                         continue;
                     }
                     let step = (b - a) / (grid - 1) as f32;
-                    let prof = if by_image[k][side] {
-                        self.edge_profile_by_image(st, k, side, a, step, grid)
+                    let pixels = if by_image[k][side] {
+                        self.first_direct..self.n()
                     } else {
-                        self.edge_profile(st, k, side, a, step, grid)
+                        0..self.n()
                     };
+                    let prof = self.edge_profile(st, k, side, a, step, grid, pixels);
                     let cur_j = ((cur - a) / step).round().clamp(0.0, (grid - 1) as f32) as usize;
                     // Prefer the current position on ties (flat cost: an unconstrained edge).
                     let mut best = cur_j;

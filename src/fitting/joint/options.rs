@@ -78,7 +78,7 @@ pub struct JointOptions<'a> {
     /// in a channel it did not clip) by the pixels that see the light directly alone, where
     /// its image pins the edge and at least 16 of them measure it: each step of the descent
     /// on such an edge minimises their cost, the radiance at each position solved over them
-    /// too (`Problem::edge_profile_by_image`); the radiance kept is still solved over every
+    /// too (`Problem::edge_profile`); the radiance kept is still solved over every
     /// pixel after each sweep. Under a statistical water model the water pixels are one draw
     /// of the glitter about the expected image, and they pulled the orange lamp's bottom edge
     /// 0.9 mm (six of its sigmas) off where its image puts it, in the paper's close geometry

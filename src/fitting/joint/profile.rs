@@ -310,10 +310,12 @@ impl Problem {
         }
     }
 
-    /// The cost, as a function of one edge of light `k` on the grid `lo + j * step`
-    /// (`j < grid`), with light k's radiance re-optimised (closed form, nonnegative) at every
-    /// grid point and the other lights held. Returns per grid point (cost up to a constant,
-    /// the radiance).
+    /// The cost over the fitted pixels `pixels` (every one, or those that see the lights
+    /// directly alone: [`super::JointOptions::edges_by_image`]), as a function of one edge
+    /// of light `k` on the grid `lo + j * step` (`j < grid`), with light k's radiance
+    /// re-optimised over the same pixels (closed form, nonnegative) at every grid point and
+    /// the other lights held. Returns per grid point (cost up to a constant, the radiance).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn edge_profile(
         &self,
         st: &State,
@@ -322,25 +324,10 @@ impl Problem {
         lo: f32,
         step: f32,
         grid: usize,
+        pixels: std::ops::Range<usize>,
     ) -> Vec<(f64, [f64; 3])> {
-        let all = self.summed_profile(st, k, side, lo, step, grid, 0..self.n());
-        let radiance = all.radiance();
-        all.costs(radiance)
-    }
-
-    /// [`Self::edge_profile`] over the pixels that see the lights directly alone, the radiance
-    /// at each grid point solved over them too ([`super::JointOptions::edges_by_image`]).
-    pub(super) fn edge_profile_by_image(
-        &self,
-        st: &State,
-        k: usize,
-        side: EdgeSide,
-        lo: f32,
-        step: f32,
-        grid: usize,
-    ) -> Vec<(f64, [f64; 3])> {
-        let direct = self.summed_profile(st, k, side, lo, step, grid, self.first_direct..self.n());
-        direct.costs(direct.radiance())
+        self.summed_profile(st, k, side, lo, step, grid, pixels)
+            .costs()
     }
 
     /// The normal-equation sums of the fitted pixels `pixels` at every grid point of an edge
@@ -411,8 +398,10 @@ impl SummedProfile {
             .collect()
     }
 
-    /// Per grid point, the cost of these pixels (up to a constant) at `radiance`, with it.
-    fn costs(&self, radiance: Vec<[f64; 3]>) -> Vec<(f64, [f64; 3])> {
+    /// Per grid point, the cost of these pixels (up to a constant) at the radiance of their
+    /// normal equation, with it.
+    fn costs(&self) -> Vec<(f64, [f64; 3])> {
+        let radiance = self.radiance();
         let clipped = one_sided_costs(&self.clipped_flat, &self.clipped_rows, &radiance);
         radiance
             .into_iter()
@@ -483,7 +472,7 @@ mod tests {
                 (cur - 0.004, 0.0005),
                 (cur + 0.05, 0.0005),
             ] {
-                let profile = problem.edge_profile(&st, 0, side, lo, step, grid);
+                let profile = problem.edge_profile(&st, 0, side, lo, step, grid, 0..problem.n());
                 let mut costs = Vec::new();
                 for (j, (_, l)) in profile.iter().enumerate() {
                     let rect = start.with_edge(side, lo + j as f32 * step);
