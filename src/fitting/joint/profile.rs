@@ -326,23 +326,6 @@ impl Problem {
         grid: usize,
         pixels: std::ops::Range<usize>,
     ) -> Vec<(f64, [f64; 3])> {
-        self.summed_profile(st, k, side, lo, step, grid, pixels)
-            .costs()
-    }
-
-    /// The normal-equation sums of the fitted pixels `pixels` at every grid point of an edge
-    /// profile ([`Self::edge_profile`]).
-    #[allow(clippy::too_many_arguments)]
-    fn summed_profile(
-        &self,
-        st: &State,
-        k: usize,
-        side: EdgeSide,
-        lo: f32,
-        step: f32,
-        grid: usize,
-        pixels: std::ops::Range<usize>,
-    ) -> SummedProfile {
         // Fixed chunks summed in order: the same sums whatever the thread count.
         let parts: Vec<ProfileSums> = pixels
             .collect::<Vec<_>>()
@@ -374,12 +357,12 @@ impl Problem {
         for j in 0..grid {
             sum.a[j] = sum.a[j].max(0.5 * sum.a_raw[j]);
         }
-        sum
+        sum.costs()
     }
 }
 
 /// An edge profile's sums over some pixels, every chunk's added up
-/// ([`Problem::summed_profile`]).
+/// ([`Problem::edge_profile`]).
 struct SummedProfile {
     a: Vec<f64>,
     a_raw: Vec<f64>,
