@@ -332,60 +332,41 @@ impl Problem {
             .par_chunks(PROFILE_CHUNK)
             .map(|chunk| self.profile_sums(st, k, side, lo, step, grid, chunk))
             .collect();
-        let mut sum = SummedProfile {
-            a: vec![0f64; grid],
-            a_raw: vec![0f64; grid],
-            b: vec![[0f64; 3]; grid],
-            clipped_rows: Vec::new(),
-            clipped_flat: Vec::new(),
-        };
+        let mut a = vec![0f64; grid];
+        let mut a_raw = vec![0f64; grid];
+        let mut b = vec![[0f64; 3]; grid];
+        let mut clipped_rows: Vec<ClippedRow> = Vec::new();
+        let mut clipped_flat: Vec<ClippedConstant> = Vec::new();
         for part in parts {
             for j in 0..grid {
-                sum.a[j] += part.a[j] + part.flat.a;
-                sum.a_raw[j] += part.a_raw[j] + part.flat.a_raw;
-                for ((total, here), flat) in sum.b[j].iter_mut().zip(part.b[j]).zip(part.flat.b) {
+                a[j] += part.a[j] + part.flat.a;
+                a_raw[j] += part.a_raw[j] + part.flat.a_raw;
+                for ((total, here), flat) in b[j].iter_mut().zip(part.b[j]).zip(part.flat.b) {
                     *total += here + flat;
                 }
             }
-            sum.clipped_rows.extend(part.clipped_rows);
-            sum.clipped_flat.extend(part.clipped_flat);
+            clipped_rows.extend(part.clipped_rows);
+            clipped_flat.extend(part.clipped_flat);
         }
         // Pixels with no sample of light k contribute a constant, left out.
         // A rectangle that catches only a few samples has a variance as large as its mean
         // square: the corrected normal equation would divide by ~0. Keep at least half of the
         // raw term (the bias then stays bounded, and such a rectangle is far from the optimum).
         for j in 0..grid {
-            sum.a[j] = sum.a[j].max(0.5 * sum.a_raw[j]);
+            a[j] = a[j].max(0.5 * a_raw[j]);
         }
-        sum.costs()
-    }
-}
-
-/// An edge profile's sums over some pixels, every chunk's added up
-/// ([`Problem::edge_profile`]).
-struct SummedProfile {
-    a: Vec<f64>,
-    a_raw: Vec<f64>,
-    b: Vec<[f64; 3]>,
-    clipped_rows: Vec<ClippedRow>,
-    clipped_flat: Vec<ClippedConstant>,
-}
-
-impl SummedProfile {
-    /// Per grid point, the radiance of the normal equation (nonnegative).
-    fn radiance(&self) -> Vec<[f64; 3]> {
-        self.a
-            .iter()
-            .zip(&self.b)
-            .map(|(&a, b)| [0, 1, 2].map(|ch| if a > 0.0 { (b[ch] / a).max(0.0) } else { 0.0 }))
-            .collect()
-    }
-
-    /// Per grid point, the cost of these pixels (up to a constant) at the radiance of their
-    /// normal equation, with it.
-    fn costs(&self) -> Vec<(f64, [f64; 3])> {
-        let radiance = self.radiance();
-        let clipped = one_sided_costs(&self.clipped_flat, &self.clipped_rows, &radiance);
+        let radiance: Vec<[f64; 3]> = (0..grid)
+            .map(|j| {
+                [0, 1, 2].map(|ch| {
+                    if a[j] > 0.0 {
+                        (b[j][ch] / a[j]).max(0.0)
+                    } else {
+                        0.0
+                    }
+                })
+            })
+            .collect();
+        let clipped = one_sided_costs(&clipped_flat, &clipped_rows, &radiance);
         radiance
             .into_iter()
             .zip(clipped)
@@ -393,7 +374,7 @@ impl SummedProfile {
             .map(|(j, (l, clipped))| {
                 // sum (r - L c)^2 - sum r^2 = L^2 A - 2 L B
                 let cost: f64 = (0..3)
-                    .map(|ch| l[ch] * l[ch] * self.a[j] - 2.0 * l[ch] * self.b[j][ch])
+                    .map(|ch| l[ch] * l[ch] * a[j] - 2.0 * l[ch] * b[j][ch])
                     .sum::<f64>();
                 (cost + clipped, l)
             })
