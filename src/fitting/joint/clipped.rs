@@ -1,16 +1,18 @@
 //! The clipped pixels of an edge profile ([`super::profile`]) whose coefficient is the same
-//! at every grid point: their one-sided cost at every grid point's radiance, gathered for the
-//! whole grid in one pass over them.
+//! at every grid point: which of their channels count at every grid point's radiance, and
+//! their sums there, gathered for the whole grid in one pass over them.
 //!
 //! A clipped channel is a lower bound (method §2): it adds `(r0 - L c)^2` while the model
 //! `L c` stays below the photo's value (the residual `r0` with light k dark) and nothing once
-//! the model is above, so it cannot join the normal equations' sums. In the paper's setting
-//! most fitted pixels are clipped (a streak's core: 24 000 of Table 1's 30 600), and counting
-//! each at every grid point was most of the descent's time. The grid points where such a
-//! channel counts are those whose radiance lies on one side of `r0 / c`: with the grid's
-//! radiances sorted, one run of them. Each channel adds its three sums (`r0^2`, `r0 c`,
-//! `c^2`) at the run's ends as differences, and one pass along the sorted radiances
-//! evaluates `sum r0^2 - 2 L sum r0 c + L^2 sum c^2` at every grid point.
+//! the model is above, so it cannot join the normal equations' sums once for all radiances.
+//! In the paper's setting most fitted pixels are clipped (a streak's core: 24 000 of Table
+//! 1's 30 600), and counting each at every grid point was most of the descent's time. The
+//! grid points where such a channel counts are those whose radiance lies on one side of
+//! `r0 / c`: with the grid's radiances sorted, one run of them. Each channel adds its three
+//! sums (`r0^2`, `r0 c`, `c^2`) at the run's ends as differences, and one pass along the
+//! sorted radiances gives at every grid point the sums of the channels that count there: the
+//! cost `sum r0^2 - 2 L sum r0 c + L^2 sum c^2`, and the least-squares radiance of those
+//! channels (the profile's Newton step).
 
 use rayon::prelude::*;
 
@@ -30,6 +32,7 @@ impl ClippedPixel {
     /// `d`, less its cost with light k dark: as [`Problem::cost`](super::problem::Problem)
     /// counts it, `(r0 - l c)^2 - (l d + rd)^2`, for a clipped channel only while the model
     /// is below the photo (`r0 - l c >= 0`).
+    #[cfg(test)]
     fn cost(&self, ch: usize, l: f64, c: f64, d: f64) -> f64 {
         let (r0, rd) = (self.res[ch], self.rest_dev[ch]);
         let r = r0 - l * c;
@@ -61,35 +64,91 @@ pub(super) struct ClippedRow {
     pub(super) d: Vec<f32>,
 }
 
+/// The clipped pixels' channels that count at every grid point's radiance of light k (a
+/// clipped channel while the model is below the photo, a value channel always), summed.
+pub(super) struct Counted {
+    /// Per grid point and channel, `[r0^2 - rd^2, r0 c + d rd, c^2 - d^2]` over the channels
+    /// that count there: at light k's radiance `L` they add `s0 - 2 L s1 + L^2 s2`.
+    pub(super) sums: Vec<[[f64; 3]; 3]>,
+    /// What the same pixels add with light k dark.
+    dark: f64,
+}
+
+impl Counted {
+    /// The cost the clipped pixels add at grid point j with light k's radiance `l`, less what
+    /// they add with light k dark ([`ClippedPixel::cost`]): exact at the radiance they were
+    /// counted at.
+    pub(super) fn cost(&self, j: usize, l: [f64; 3]) -> f64 {
+        let s = &self.sums[j];
+        (0..3)
+            .map(|ch| s[ch][0] - 2.0 * l[ch] * s[ch][1] + l[ch] * l[ch] * s[ch][2])
+            .sum::<f64>()
+            - self.dark
+    }
+}
+
+/// The clipped pixels (`constant` and `rows`) counted at light k's radiance `radiance[j]` at
+/// every grid point j.
+pub(super) fn counted(
+    constant: &[ClippedConstant],
+    rows: &[ClippedRow],
+    radiance: &[[f64; 3]],
+) -> Counted {
+    let mut sums = vec![[[0f64; 3]; 3]; radiance.len()];
+    let mut dark = 0f64;
+    for ch in 0..3 {
+        let channel: Vec<f64> = radiance.iter().map(|l| l[ch]).collect();
+        dark += add_constant_sums(constant, ch, &channel, &mut sums);
+    }
+    for row in rows {
+        for ch in 0..3 {
+            let (r0, rd) = (row.pixel.res[ch], row.pixel.rest_dev[ch]);
+            let bound = row.pixel.bound[ch];
+            if !bound || r0 >= 0.0 {
+                dark += r0 * r0 - rd * rd;
+            }
+            for (j, (s, l)) in sums.iter_mut().zip(radiance).enumerate() {
+                let (c, d) = (row.c[j] as f64, row.d[j] as f64);
+                if !bound || r0 - l[ch] * c >= 0.0 {
+                    let s = &mut s[ch];
+                    s[0] += r0 * r0 - rd * rd;
+                    s[1] += r0 * c + d * rd;
+                    s[2] += c * c - d * d;
+                }
+            }
+        }
+    }
+    Counted { sums, dark }
+}
+
 /// Per grid point j, the cost the clipped pixels (`constant` and `rows`) add when light k's
 /// radiance is `radiance[j]`, less what they add with light k dark ([`ClippedPixel::cost`]).
+#[cfg(test)]
 pub(super) fn one_sided_costs(
     constant: &[ClippedConstant],
     rows: &[ClippedRow],
     radiance: &[[f64; 3]],
 ) -> Vec<f64> {
-    let mut cost = vec![0f64; radiance.len()];
-    for ch in 0..3 {
-        let channel: Vec<f64> = radiance.iter().map(|l| l[ch]).collect();
-        add_constant_costs(constant, ch, &channel, &mut cost);
-    }
-    for row in rows {
-        for (j, (cost, l)) in cost.iter_mut().zip(radiance).enumerate() {
-            let (c, d) = (row.c[j] as f64, row.d[j] as f64);
-            *cost += (0..3)
-                .map(|ch| row.pixel.cost(ch, l[ch], c, d))
-                .sum::<f64>();
-        }
-    }
-    cost
+    let counted = counted(constant, rows, radiance);
+    radiance
+        .iter()
+        .enumerate()
+        .map(|(j, &l)| counted.cost(j, l))
+        .collect()
 }
 
-/// Clipped pixels per parallel piece of [`add_constant_costs`].
+/// Clipped pixels per parallel piece of [`add_constant_sums`].
 const CHUNK: usize = 4096;
 
-/// Adds to `cost` the `constant` pixels' cost in channel `ch` at every grid point, whose
-/// radiance in that channel is `radiance` (see the module doc).
-fn add_constant_costs(constant: &[ClippedConstant], ch: usize, radiance: &[f64], cost: &mut [f64]) {
+/// Adds to `sums[j][ch]` the `constant` pixels' sums in channel `ch` that count at every grid
+/// point j, whose radiance in that channel is `radiance` (see the module doc); returns their
+/// cost with light k dark.
+fn add_constant_sums(
+    constant: &[ClippedConstant],
+    ch: usize,
+    radiance: &[f64],
+    sums: &mut [[[f64; 3]; 3]],
+) -> f64 {
     let grid = radiance.len();
     let mut order: Vec<usize> = (0..grid).collect();
     order.sort_by(|&a, &b| radiance[a].total_cmp(&radiance[b]));
@@ -109,14 +168,16 @@ fn add_constant_costs(constant: &[ClippedConstant], ch: usize, radiance: &[f64],
         }
         dark += part_dark;
     }
-    let mut sums = [0f64; 3];
+    let mut running = [0f64; 3];
     for (m, &j) in order.iter().enumerate() {
         for s in 0..3 {
-            sums[s] += total[m][s];
+            running[s] += total[m][s];
         }
-        let l = sorted[m];
-        cost[j] += sums[0] - 2.0 * l * sums[1] + l * l * sums[2] - dark;
+        for s in 0..3 {
+            sums[j][ch][s] += running[s];
+        }
     }
+    dark
 }
 
 /// The `pixels`' sums in channel `ch` as steps along the grid's radiances `sorted` (at

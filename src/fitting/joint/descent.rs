@@ -2,8 +2,8 @@
 //! each step a global search on a grid of positions that shrinks around the best.
 //!
 //! Each 1-D step evaluates the cost on a whole grid of edge positions in one pass over the
-//! samples ([`Problem::edge_profile`]), with that light's radiance re-optimised in closed form
-//! at every grid point, so a far-off start (the paper's estimate can be metres off) is pulled
+//! samples ([`Problem::edge_profile`]), with that light's radiance re-optimised at every grid
+//! point, so a far-off start (the paper's estimate can be metres off) is pulled
 //! in by a global 1-D search rather than a local step. The grid then shrinks around the best
 //! position until it is finer than a ten-thousandth of the light's size. An edge that no pixel of the streak's edge
 //! looks at (outside the photo) is held where the paper method put it.

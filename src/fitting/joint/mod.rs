@@ -42,7 +42,7 @@
 //! (`descent`) where each 1D step evaluates the cost on a whole grid of edge positions in
 //! one pass over the samples near it (`near`; prefix sums over binned samples: `ramps`,
 //! `profile`; polynomials where the coefficients are smooth: `pieces`), with
-//! that light's radiance re-optimised in closed form at every grid point, so a far-off start
+//! that light's radiance re-optimised at every grid point, so a far-off start
 //! (the paper's estimate can be metres off) is pulled in by a global 1D search rather than a
 //! local step. The grid then shrinks around the best position until it is finer than a
 //! millimetre. An edge that no pixel of the streak's edge looks at (outside the photo) is
