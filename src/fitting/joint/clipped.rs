@@ -76,8 +76,8 @@ pub(super) struct Counted {
 
 impl Counted {
     /// The cost the clipped pixels add at grid point j with light k's radiance `l`, less what
-    /// they add with light k dark ([`ClippedPixel::cost`]): exact at the radiance they were
-    /// counted at.
+    /// they add with light k dark (as [`Problem::cost`](super::problem::Problem) counts
+    /// them): exact at the radiance they were counted at.
     pub(super) fn cost(&self, j: usize, l: [f64; 3]) -> f64 {
         let s = &self.sums[j];
         (0..3)
@@ -119,22 +119,6 @@ pub(super) fn counted(
         }
     }
     Counted { sums, dark }
-}
-
-/// Per grid point j, the cost the clipped pixels (`constant` and `rows`) add when light k's
-/// radiance is `radiance[j]`, less what they add with light k dark ([`ClippedPixel::cost`]).
-#[cfg(test)]
-pub(super) fn one_sided_costs(
-    constant: &[ClippedConstant],
-    rows: &[ClippedRow],
-    radiance: &[[f64; 3]],
-) -> Vec<f64> {
-    let counted = counted(constant, rows, radiance);
-    radiance
-        .iter()
-        .enumerate()
-        .map(|(j, &l)| counted.cost(j, l))
-        .collect()
 }
 
 /// Clipped pixels per parallel piece of [`add_constant_sums`].
@@ -229,6 +213,21 @@ fn steps(pixels: &[ClippedConstant], ch: usize, sorted: &[f64]) -> (Vec<[f64; 3]
 mod tests {
     use super::*;
 
+    /// Per grid point j, the cost the clipped pixels (`constant` and `rows`) add when light k's
+    /// radiance is `radiance[j]`, less what they add with light k dark ([`ClippedPixel::cost`]).
+    fn one_sided_costs(
+        constant: &[ClippedConstant],
+        rows: &[ClippedRow],
+        radiance: &[[f64; 3]],
+    ) -> Vec<f64> {
+        let counted = counted(constant, rows, radiance);
+        radiance
+            .iter()
+            .enumerate()
+            .map(|(j, &l)| counted.cost(j, l))
+            .collect()
+    }
+
     #[test]
     fn gathered_costs_are_the_pixels_counted_one_by_one() {
         // Pixels with positive, negative and zero coefficients, residuals of both signs,
@@ -284,6 +283,34 @@ mod tests {
         // flat profile keeps its current position).
         let flat = one_sided_costs(&constant, &[], &vec![radiance[3]; 65]);
         assert!(flat.iter().all(|&c| c == flat[0]), "{flat:?}");
+        // The same pixels as rows, their coefficient and half-difference changing over the
+        // grid: again each pixel's own cost at every grid point.
+        let rows: Vec<ClippedRow> = constant[..300]
+            .iter()
+            .map(|p| ClippedRow {
+                pixel: p.pixel,
+                c: (0..65)
+                    .map(|j| (p.c * (0.5 + j as f64 / 64.0)) as f32)
+                    .collect(),
+                d: (0..65)
+                    .map(|j| (p.d * (1.5 - j as f64 / 64.0)) as f32)
+                    .collect(),
+            })
+            .collect();
+        let got = one_sided_costs(&[], &rows, &radiance);
+        for (j, (g, l)) in got.iter().zip(&radiance).enumerate() {
+            let want: f64 = rows
+                .iter()
+                .flat_map(|r| {
+                    let (c, d) = (r.c[j] as f64, r.d[j] as f64);
+                    (0..3).map(move |ch| r.pixel.cost(ch, l[ch], c, d))
+                })
+                .sum();
+            assert!(
+                (g - want).abs() <= 1e-12 * scale,
+                "row grid point {j}: {g} against {want}"
+            );
+        }
     }
 
     #[test]
