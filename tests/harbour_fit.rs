@@ -30,9 +30,11 @@ use streaklight::water_model::water_statistics;
 /// every channel (the warm white sign) has only the reflections to give its radiance, and one
 /// realisation of the waves gives it no better than that realisation holds the expected
 /// light (the sign's photo holds 5.4 % less than its expectation:
-/// `tests/water_model.rs`, `the_signs_photo_holds_less_light_than_its_expectation`): held
-/// within 3 of its sigma (a sigma too small for that shortfall fails there) and the sigma
-/// under 6 % (measured: 2.9-3.7 % low at sigma 4.8 %, fit seeds 1-3).
+/// `tests/water_model.rs`, `the_signs_photo_holds_less_light_than_its_expectation`; over 16
+/// other wave fields the fit's radiance scatters by 7.8 % rms, `cargo bench --bench
+/// realisations`): held within 3 of its sigma (a sigma too small for that shortfall fails
+/// there) and the sigma under 11 %, the realisations' floor of 10 % of the radiance fitted
+/// (measured: 3.0-3.6 % low at sigma 9.6 %).
 fn assert_layout(layout: &str, scene: &Scene, lit: &Lit) {
     let layouts = harbour::layouts();
     let truths = &layouts.iter().find(|l| l.0 == layout).unwrap().2;
@@ -78,7 +80,7 @@ fn assert_layout(layout: &str, scene: &Scene, lit: &Lit) {
         let (bar, sigma_bar) = if sigma.radiance_seen {
             (Some(0.03), 0.02)
         } else {
-            (None, 0.06)
+            (None, 0.11)
         };
         for c in 0..3 {
             let error = fitted.radiance[c] as f64 / t.radiance[c] - 1.0;
@@ -316,4 +318,66 @@ fn the_sign_over_other_waves_and_a_flat_quad() {
     for scene in ["harbour-other-waves.gltf", "harbour-flat.gltf"] {
         statistical_in_frame(scene, "sign");
     }
+}
+
+/// The sign over the wave field of seed 13 of `cargo bench --bench realisations`, the field
+/// of sixteen whose reflections hold the least of the sign's light: rendered as the sample
+/// photos are and fitted against the flat quad at the defaults, the sign comes out one light
+/// with its edges from its image, and its radiance, which only the reflections give, 19.8 %
+/// low (measured). That is one realisation of the waves, not something the fit can see, so
+/// its sigma must cover it: within 3 sigmas at the realisations' floor of 10 % of the
+/// radiance fitted (2.5 sigmas; 4.9 at a floor of 5 %). The report's warning says what would
+/// let the photo give the radiance.
+#[test]
+fn a_sign_over_waves_that_reflect_little_is_within_its_sigmas() {
+    use streaklight::render::{render, RenderOptions};
+    use streaklight::samples::realisation::write_over_waves;
+
+    let dir = common::dirs::temp_dir("sign-over-seed-13");
+    let truth = write_over_waves("harbour-sign-truth.gltf", 13, &dir).unwrap();
+    let over = streaklight::scene_in::load(&truth, &Default::default()).unwrap();
+    let image = render(
+        &over,
+        &RenderOptions {
+            width: samples::PHOTO_SIZE,
+            height: samples::PHOTO_SIZE,
+            samples_per_pixel: samples::PHOTO_SPP,
+            exposure: samples::PHOTO_EXPOSURE,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let png = dir.join("sign-13.png");
+    streaklight::photo_out::write(&png, image.width, image.height, &image.pixels).unwrap();
+    let photo = streaklight::photo_in::load(&png, samples::PHOTO_EXPOSURE).unwrap();
+    let fitting = sample_scene("harbour-flat.gltf", None);
+    let lit = pipeline::fit(
+        &fitting,
+        &photo,
+        &FitSettings::default(),
+        Reporter::default(),
+    )
+    .unwrap();
+    assert_eq!(lit.water_model.model, "statistical");
+    assert_layout("sign", &fitting, &lit);
+    let layouts = harbour::layouts();
+    let truth = &layouts.iter().find(|l| l.0 == "sign").unwrap().2[0];
+    let error = lit.lights[0].radiance[0] as f64 / truth.radiance[0] - 1.0;
+    assert!(error < -0.1, "radiance {:+.1} %", 100.0 * error);
+    // The report warns of the radiance's uncertainty, and says what would let the photo
+    // give it: the lamp's image is in the photo, clipped in every channel.
+    let report = streaklight::report::light_report(
+        &fitting,
+        &lit.lights[0],
+        Some(&lit.uncertainties[0]),
+        "sign".into(),
+    );
+    let warning = streaklight::report::light_warnings(&report).unwrap_or_default();
+    assert!(
+        warning.contains("large uncertainty")
+            && warning.contains("clipped in every channel")
+            && warning.contains("a shorter exposure"),
+        "{warning}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -104,9 +104,12 @@ fn the_scenes_own_waves_keep_the_exact_model() {
 /// here). Every edge (pinned by the light's direct image) and every radiance channel lies
 /// within 3 of its reported sigmas: the radiance, which the direct image clipped in every
 /// channel leaves to the reflections, comes out 7.5 % low, the photo's waves holding 9 % less
-/// light than their expectation (the test below), and its sigma is held at 5 % of it at
-/// least ([`streaklight::fitting::slopes::REALISATION_FLUX`]). Forcing the exact model is
-/// reported as forced.
+/// light than their expectation (the test below), and its sigma is held at 10 % of it at
+/// least ([`streaklight::fitting::slopes::REALISATION_FLUX`]). Not all of that shortfall is
+/// this photo's waves: over 16 other wave fields of the same ripples the fit's radiance came
+/// out 4.7 % low on average, 2.3 % rms about that (`cargo bench --bench realisations`), so
+/// the expectation close to the water holds about 5 % more light than such waves reflect.
+/// Forcing the exact model is reported as forced.
 #[test]
 fn a_flat_quad_takes_the_statistical_model() {
     let waves = sample_scene("scene.gltf", None);

@@ -43,8 +43,20 @@ pub fn light_warnings(light: &LightReport) -> Option<String> {
         let brightest = light.radiance.iter().cloned().fold(0.0, f64::max);
         let worst = u.radiance.iter().cloned().fold(0.0, f64::max);
         if brightest > 0.0 && worst > LARGE_UNCERTAINTY * brightest {
+            // A light the photo shows, but not whole and unclipped in any channel: its
+            // radiance comes from its reflections alone, which one photo's waves move by
+            // several percent; its own image could give it.
+            let advice = if light.radiance_seen == Some(false)
+                && light.direct_pixels.is_some_and(|n| n > 0)
+            {
+                " (only its reflections give it: its image is clipped in every channel or cut \
+                 by the frame; a shorter exposure, or a frame that holds the whole lamp, lets \
+                 its image give it)"
+            } else {
+                ""
+            };
             large.push(format!(
-                "radiance +-{worst:.3} ({:.1} % of {brightest:.3})",
+                "radiance +-{worst:.3} ({:.1} % of {brightest:.3}){advice}",
                 100.0 * worst / brightest
             ));
         }

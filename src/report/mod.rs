@@ -155,7 +155,7 @@ pub struct LightReport {
     /// Whether the photo shows the light whole in a channel it did not clip, so that its
     /// radiance is read off its image (the other channels from its colour); `false` when only
     /// its reflections give it (out of frame, hidden, or clipped in every channel), whose
-    /// radiance sigma under the statistical water model is then at least 5 % of it; `None`
+    /// radiance sigma under the statistical water model is then at least 10 % of it; `None`
     /// with `--method paper`.
     pub radiance_seen: Option<bool>,
     /// Index of the light in the output's `EXT_lights_area.lights`.

@@ -168,12 +168,12 @@ pub fn grid_rows() -> Vec<GridRow> {
 
 /// The water mesh of wave realisation `realisation` (0: the photos', 1: the other).
 pub fn water_mesh(realisation: usize) -> WaterMesh {
-    mesh_rows(
-        &harbour_waves(realisation),
-        &grid_rows(),
-        HARBOUR_COLUMNS,
-        0.5,
-    )
+    water_mesh_of(&harbour_waves(realisation))
+}
+
+/// The harbour's water grid over the waves `field`.
+pub fn water_mesh_of(field: &RippleField) -> WaterMesh {
+    mesh_rows(field, &grid_rows(), HARBOUR_COLUMNS, 0.5)
 }
 
 /// The flat water: one quad over the grid's extent.

@@ -24,6 +24,7 @@ pub mod gltf_doc;
 pub mod harbour;
 pub mod harbour_waves;
 mod mesh_size;
+pub mod realisation;
 #[cfg(test)]
 pub(crate) use fixture::{fixture, load_fixture, Fixture};
 pub mod shapes;
@@ -378,12 +379,17 @@ pub fn water_grid() -> GridSpec {
 
 /// The ripples of every sample photo.
 pub fn ripples() -> RippleField {
-    RippleField::new(2018, 24, 0.05)
+    ripples_of(2018)
 }
 
 /// Another realisation of the same ripples: the water of `scene-other-waves.gltf`.
 pub fn other_ripples() -> RippleField {
-    RippleField::new(1202, 24, 0.05)
+    ripples_of(1202)
+}
+
+/// The realisation of the samples' ripples (24 of rms slope 0.05) drawn from `seed`.
+pub fn ripples_of(seed: u64) -> RippleField {
+    RippleField::new(seed, 24, 0.05)
 }
 
 /// The wall of the paper's setup at `z`, facing +z.
