@@ -21,7 +21,9 @@
 //! pixel's centre) meets the light's plane first, within the start rectangle grown by its own
 //! larger side on every side, and that are bright (clipped in some channel, or at least half
 //! the brightest such pixel's largest channel); of their 8-connected groups in the image,
-//! the one whose centre on the plane is nearest the start's centre.
+//! the one whose centre on the plane is nearest the start's centre. Where that rectangle cuts
+//! the group (a small start under a large lamp), it grows to hold the group, so that a
+//! fragment's start finds the lamp's whole image, the one a start on the lamp finds.
 
 use super::dark_wall::trimmed_to_unseen_wall;
 use super::direct_images::{images_in, DirectImage};
@@ -161,9 +163,22 @@ fn direct_image(
     light: &FittedLight,
 ) -> Option<DirectImage> {
     let start = light.rect();
-    let search = start.grow(start.width().max(start.height()));
-    let images = images_in(scene, photo, water, &light.plane, search);
     let centre = start.center();
+    // The image nearest the start, whole: where the search rectangle cuts it (a start from
+    // a small fragment of a streak, under a large lamp), the rectangle grows to hold it,
+    // so that the image, and its identity, do not depend on the start's size.
+    let mut search = start.grow(start.width().max(start.height()));
+    let mut images = images_in(scene, photo, water, &light.plane, search);
+    for _ in 0..MAX_WIDENINGS {
+        let Some(im) = nearest(&images, centre) else {
+            break;
+        };
+        if !reaches(&im.rect, &search, im.footprint) {
+            break;
+        }
+        search = search.union(&im.rect.grow(im.rect.width().max(im.rect.height())));
+        images = images_in(scene, photo, water, &light.plane, search);
+    }
     // What the start may be trimmed to: every image it overlaps (two stacked lamps the
     // reflections started as one light are two images), enclosed only if all of them are.
     let overlapped: Vec<&DirectImage> = images
@@ -179,18 +194,38 @@ fn direct_image(
         }))
     });
     let all_enclosed = overlapped.iter().all(|im| im.enclosed);
+    let first = nearest(&images, centre)?.first_pixel;
     images
         .into_iter()
-        .min_by(|a, b| {
-            let da = (a.rect.center() - centre).length();
-            let db = (b.rect.center() - centre).length();
-            da.total_cmp(&db)
-        })
+        .find(|im| im.first_pixel == first)
         .map(|im| DirectImage {
             enclosed: im.enclosed && all_enclosed,
             reach: reach.unwrap_or(im.rect),
             ..im
         })
+}
+
+/// The image of `images` whose centre lies nearest `centre`.
+fn nearest(images: &[DirectImage], centre: glam::Vec2) -> Option<&DirectImage> {
+    images.iter().min_by(|a, b| {
+        let da = (a.rect.center() - centre).length();
+        let db = (b.rect.center() - centre).length();
+        da.total_cmp(&db)
+    })
+}
+
+/// Most times [`direct_image`]'s search rectangle grows to hold the image it cuts: each
+/// growth at least doubles its reach beyond the image found, and a lamp that a start's
+/// rectangle grown three times over cannot hold is no fragment's.
+const MAX_WIDENINGS: usize = 3;
+
+/// Whether `image` (a direct image's rectangle, grown by half a pixel's `footprint`) reaches
+/// the edge of the rectangle `search` it was looked for in: the search may have cut it.
+fn reaches(image: &Rect, search: &Rect, footprint: f32) -> bool {
+    image.u_min <= search.u_min + footprint
+        || image.u_max >= search.u_max - footprint
+        || image.v_min <= search.v_min + footprint
+        || image.v_max >= search.v_max - footprint
 }
 
 #[cfg(test)]
@@ -295,6 +330,45 @@ pub(super) mod tests {
         let kept = direct_starts(scene, photo, water, &[light(&plane, inside, 0)]);
         assert_eq!(kept.len(), 1);
         assert_eq!(kept[0].rect(), inside);
+    }
+
+    /// A start from a small fragment of a streak, under the lamp and barely reaching its
+    /// image (as one wave field's reflections started one for Table 1's lamp): the rectangle
+    /// it searches cuts the lamp's image, and grows to hold it, so it finds the whole image
+    /// (enclosed, within a pixel's footprint of the truth), the one a start on the lamp
+    /// finds, and the two merge whichever comes first: one lamp, one light. Taking the cut
+    /// piece for an image of its own gave the lamp two lights.
+    #[test]
+    fn a_small_start_under_a_large_image_finds_it_whole() {
+        let (scene, photo, water, plane, truth) = table1();
+        let footprint = 10.0 * 2.0 * (30f32.to_radians()).tan() / photo.height as f32;
+        let c = truth.center();
+        let small = Rect {
+            u_min: c.x - 0.4,
+            u_max: c.x + 0.4,
+            v_min: truth.v_min - 1.3,
+            v_max: truth.v_min + 0.15,
+        };
+        // Its own search rectangle alone stops short of the image's top.
+        let search = small.grow(small.width().max(small.height()));
+        assert!(search.v_max < truth.v_max - 1.0, "{search:?}");
+        let image = direct_image(scene, photo, water, &light(&plane, small, 1)).unwrap();
+        assert!(image.enclosed);
+        assert_within(&image.rect, &truth, footprint);
+        let on_lamp = light(&plane, truth.grow(-0.3), 0);
+        for starts in [
+            [light(&plane, small, 1), on_lamp.clone()],
+            [on_lamp.clone(), light(&plane, small, 1)],
+        ] {
+            let out = direct_starts(scene, photo, water, &starts);
+            assert_eq!(
+                out.len(),
+                1,
+                "{:?}",
+                out.iter().map(|l| l.rect()).collect::<Vec<_>>()
+            );
+            assert_eq!(out[0].streak_ids, vec![0, 1]);
+        }
     }
 
     /// A start on the light's whole image learns where the light ends: the image's
