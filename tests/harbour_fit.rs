@@ -115,11 +115,20 @@ fn assert_pair(scene: &Scene, lit: &Lit) {
 /// sample scene `scene`: the statistical model, chosen by the photo, and the lights as
 /// [`assert_layout`] holds them.
 fn statistical_in_frame(scene: &str, layout: &str) {
+    statistical_fit(
+        scene,
+        &sample_photo(&format!("harbour-{layout}.png")),
+        layout,
+    );
+}
+
+/// `fit` at the defaults of `photo`, a photo of harbour layout `layout`, against sample scene
+/// `scene`, held as [`statistical_in_frame`] holds it; returns the scene and the fit.
+fn statistical_fit(scene: &str, photo: &Photo, layout: &str) -> (Scene, Lit) {
     let fitting = sample_scene(scene, None);
-    let photo = sample_photo(&format!("harbour-{layout}.png"));
     let lit = pipeline::fit(
         &fitting,
-        &photo,
+        photo,
         &FitSettings::default(),
         Reporter::default(),
     )
@@ -131,6 +140,7 @@ fn statistical_in_frame(scene: &str, layout: &str) {
         "{used:?}"
     );
     assert_layout(layout, &fitting, &lit);
+    (fitting, lit)
 }
 
 #[test]
@@ -330,7 +340,7 @@ fn the_sign_over_other_waves_and_a_flat_quad() {
 /// let the photo give the radiance.
 #[test]
 fn a_sign_over_waves_that_reflect_little_is_within_its_sigmas() {
-    use streaklight::render::{render, RenderOptions};
+    use streaklight::render::render;
     use streaklight::samples::realisation::write_over_waves;
 
     let dir = common::dirs::temp_dir("sign-over-seed-13");
@@ -350,16 +360,7 @@ fn a_sign_over_waves_that_reflect_little_is_within_its_sigmas() {
     let png = dir.join("sign-13.png");
     streaklight::photo_out::write(&png, image.width, image.height, &image.pixels).unwrap();
     let photo = streaklight::photo_in::load(&png, samples::PHOTO_EXPOSURE).unwrap();
-    let fitting = sample_scene("harbour-flat.gltf", None);
-    let lit = pipeline::fit(
-        &fitting,
-        &photo,
-        &FitSettings::default(),
-        Reporter::default(),
-    )
-    .unwrap();
-    assert_eq!(lit.water_model.model, "statistical");
-    assert_layout("sign", &fitting, &lit);
+    let (fitting, lit) = statistical_fit("harbour-flat.gltf", &photo, "sign");
     let layouts = harbour::layouts();
     let truth = &layouts.iter().find(|l| l.0 == "sign").unwrap().2[0];
     let error = lit.lights[0].radiance[0] as f64 / truth.radiance[0] - 1.0;
