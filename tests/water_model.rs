@@ -107,7 +107,7 @@ fn the_scenes_own_waves_keep_the_exact_model() {
 /// light than their expectation (the test below), and its sigma is held at 10 % of it at
 /// least ([`streaklight::fitting::slopes::REALISATION_FLUX`]). Not all of that shortfall is
 /// this photo's waves: over 16 other wave fields of the same ripples the fit's radiance came
-/// out 4.7 % low on average, 2.3 % rms about that (`cargo bench --bench realisations`), so
+/// out 5.2 % low on average, 1.9 % rms about that (`cargo bench --bench realisations`), so
 /// the expectation close to the water holds about 5 % more light than such waves reflect.
 /// Forcing the exact model is reported as forced.
 #[test]

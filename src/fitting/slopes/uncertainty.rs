@@ -89,7 +89,7 @@ pub fn correlation_area(
 /// --bench realisations` (BENCHMARKS.md): the harbour's sign, its image clipped in every
 /// channel, rendered over 16 wave fields of the harbour's statistics and fitted against the
 /// flat quad, came out 7.8 % rms off (from 19.8 % low to 12.3 % high, mean -1.3 %); Table 1's
-/// lamp, close to the water, 4.7 % low on average with 2.3 % of scatter. 10 % covers both as
+/// lamp, close to the water, 5.2 % low on average with 1.9 % of scatter. 10 % covers both as
 /// one sigma: the largest, 19.8 % low, is 2.5 sigmas of the radiance it was fitted at.
 pub const REALISATION_FLUX: f64 = 0.10;
 
