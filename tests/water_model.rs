@@ -7,12 +7,12 @@ mod common;
 
 use common::pipeline::{sample_photo, sample_scene};
 use common::truth::{assert_within_sigmas, nearest};
+use common::water::{flattened, water_pixels};
 use streaklight::pipeline::{self, FitSettings, WaterChoice};
 use streaklight::progress::Reporter;
 use streaklight::report::light_report;
 use streaklight::samples;
 use streaklight::scene_in::Scene;
-use streaklight::tracing::{Tracer, Triangle};
 use streaklight::water_model::water_statistics;
 
 /// The settings with the water model chosen from the photo.
@@ -21,31 +21,6 @@ fn auto() -> FitSettings {
         water: WaterChoice::Auto,
         ..FitSettings::default()
     }
-}
-
-/// `scene` with its water flattened onto its mean level (world y = 0), normals straight up.
-fn flattened(mut scene: Scene) -> Scene {
-    let level = -scene.origin.y as f32;
-    for ((t, n), &w) in scene
-        .triangles
-        .iter_mut()
-        .zip(scene.normals.iter_mut())
-        .zip(&scene.is_water)
-    {
-        if w {
-            for v in t.iter_mut() {
-                v.y = level;
-            }
-            *n = [glam::Vec3::Y; 3];
-        }
-    }
-    let triangles: Vec<Triangle> = scene
-        .triangles
-        .iter()
-        .map(|&vertices| Triangle { vertices })
-        .collect();
-    scene.tracer = Tracer::new(&triangles);
-    scene
 }
 
 /// The statistical water over `scene`'s mean plane with the harbour waves' own slope
@@ -64,18 +39,6 @@ fn harbour_expectation(
             spectrum.rms_slope_across.powi(2) as f32,
         ],
     }
-}
-
-/// Per pixel of a `w` x `h` image, whether the camera ray through its centre meets the
-/// water first.
-fn water_pixels(scene: &Scene, w: u32, h: u32) -> Vec<bool> {
-    use streaklight::render::{camera_hit, CameraHit};
-    (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            matches!(camera_hit(scene, &[], x, y, w, h), CameraHit::Water(_))
-        })
-        .collect()
 }
 
 /// Table 1's photo was rendered from the scene's own water mesh: the fit keeps the exact model,
@@ -406,110 +369,6 @@ fn reflected_rays_above_the_crests_meet_what_the_whole_scene_shows_them() {
         "{rays} rays, {walls} on walls"
     );
     assert!(grazing > 100, "{grazing} grazing rays of {rays}");
-}
-
-/// In the paper's close geometry (camera 0.2 m above the water, reflections 0.4-1 m in front
-/// of it) the statistical model is right and the photo is not its expectation. Over a flat
-/// quad the model without waves is the exact model's flat water (Gaussian slopes of the
-/// gloss's variance, Smith's masking, against Blinn-Phong and the paper's geometry term),
-/// band by band of 20 rows; the exact render of Table 1's light over the photo's own waves is
-/// the photo; and those waves reflect 9 % less light than flat water of the same gloss: 15 %
-/// less over the nearer half of the streak, 4 % over the farther, the farthest rows brighter
-/// than flat water makes them (a streak there holds one or two of the longest waves, and
-/// their particular shape, not their statistics, sets its light). This is the radiance the
-/// statistical fit misses there (docs/method.md §10); no slope variance gives it back, since
-/// the waves' slopes move the model's flux by under half a percent.
-#[test]
-fn close_to_the_water_the_photos_waves_hold_less_light_than_their_expectation() {
-    use streaklight::render::{render_with_lights, RenderOptions};
-    use streaklight::water_model::{StatisticalSurface, WaterModel};
-
-    let truth = sample_scene("table1-truth.gltf", None);
-    let photo = sample_photo("table1.png");
-    let (w, h) = (photo.width, photo.height);
-    let flat = flattened(sample_scene("table1-truth.gltf", None));
-    let lights = &truth.area_lights;
-    fn options(w: u32, h: u32, water: Option<&dyn WaterModel>) -> RenderOptions<'_> {
-        RenderOptions {
-            width: w,
-            height: h,
-            samples_per_pixel: 64,
-            water,
-            ..Default::default()
-        }
-    }
-    let surface = water_statistics(&flat, w, h).unwrap().surface;
-    let expected = |waves: [f32; 2]| {
-        let water = StatisticalSurface { surface, waves };
-        render_with_lights(&flat, lights, &options(w, h, Some(&water)))
-            .unwrap()
-            .pixels
-    };
-    let statistical = expected([0.0, 0.0]);
-    let wavy = expected([2e-3, 1e-3]);
-    let exact_flat = render_with_lights(&flat, lights, &options(w, h, None))
-        .unwrap()
-        .pixels;
-    let exact_waves = render_with_lights(&truth, lights, &options(w, h, None))
-        .unwrap()
-        .pixels;
-    // Flux per band of 20 rows over the water.
-    let on_water = water_pixels(&flat, w, h);
-    let bands = |img: &[[f32; 3]]| {
-        let mut out = vec![0f64; (h as usize).div_ceil(20)];
-        for (i, p) in img.iter().enumerate() {
-            if on_water[i] {
-                out[i / w as usize / 20] += (p[0] + p[1] + p[2]) as f64;
-            }
-        }
-        out
-    };
-    let total = |b: &[f64]| b.iter().sum::<f64>();
-    let (p, s, e, ew) = (
-        bands(&photo.radiance),
-        bands(&statistical),
-        bands(&exact_flat),
-        bands(&exact_waves),
-    );
-    let all = total(&e);
-    for (k, (sk, ek)) in s.iter().zip(&e).enumerate() {
-        if *ek > 0.02 * all {
-            println!("rows {}: statistical / exact {:.4}", 20 * k, sk / ek);
-            assert!(
-                (sk / ek - 1.0).abs() < 0.03,
-                "rows {}: {:.4}",
-                20 * k,
-                sk / ek
-            );
-        }
-    }
-    let model = total(&s) / total(&e);
-    let slopes = total(&bands(&wavy)) / total(&s);
-    let own = total(&ew) / total(&p);
-    let waves = total(&p) / total(&e);
-    println!(
-        "flux: statistical / exact flat {model:.4}, with slopes {slopes:.4}, exact over the \
-         photo's waves / photo {own:.4}, photo / exact flat {waves:.4}"
-    );
-    assert!((model - 1.0).abs() < 0.01, "{model}");
-    assert!((slopes - 1.0).abs() < 0.01, "{slopes}");
-    assert!((own - 1.0).abs() < 0.005, "{own}");
-    assert!((0.87..0.94).contains(&waves), "{waves}");
-    // The near rows (the lower half of the streak) lose most.
-    let rows_with_light: Vec<usize> = (0..e.len()).filter(|&k| e[k] > 0.02 * all).collect();
-    let half = rows_with_light.len() / 2;
-    let ratio = |ks: &[usize]| {
-        ks.iter().map(|&k| p[k]).sum::<f64>() / ks.iter().map(|&k| e[k]).sum::<f64>()
-    };
-    let (far, near) = (
-        ratio(&rows_with_light[..half]),
-        ratio(&rows_with_light[half..]),
-    );
-    println!("photo / exact flat: far rows {far:.3}, near rows {near:.3}");
-    assert!(
-        near < 0.9 && far > near + 0.08,
-        "far {far:.3}, near {near:.3}"
-    );
 }
 
 /// The harbour sign (a warm white light whose direct image clips in every channel, so that

@@ -166,21 +166,44 @@ pub struct GridRow {
 /// Meshes `field` on the grid `spec`, with the prefilter's Gaussian as wide as the grid's
 /// spacing.
 pub fn mesh(field: &RippleField, spec: &GridSpec) -> WaterMesh {
-    // Rows uniform in the tangent of the angle below the horizon, as image rows are.
-    let (t_near, t_far) = (spec.eye_height / spec.near, spec.eye_height / spec.far);
-    let row_distance =
-        |j: f64| spec.eye_height / (t_near + (t_far - t_near) * j / spec.rows as f64);
     let rows: Vec<GridRow> = (0..=spec.rows)
         .map(|j| {
-            let d = row_distance(j as f64);
+            let d = spec.row_distance(j as f64);
             GridRow {
                 z: spec.eye_z - d,
-                dz: (row_distance(j as f64 + 0.5) - row_distance(j as f64 - 0.5)).abs(),
+                dz: spec.row_spacing(j as f64),
                 half_width: spec.half_width_per_distance * d,
             }
         })
         .collect();
     mesh_rows(field, &rows, spec.columns, 1.0)
+}
+
+impl GridSpec {
+    /// The distance from the camera of (fractional) row `j`: rows are uniform in the tangent
+    /// of the angle below the horizon, as image rows are.
+    fn row_distance(&self, j: f64) -> f64 {
+        let (t_near, t_far) = (self.eye_height / self.near, self.eye_height / self.far);
+        self.eye_height / (t_near + (t_far - t_near) * j / self.rows as f64)
+    }
+
+    /// The spacing along z around (fractional) row `j`.
+    fn row_spacing(&self, j: f64) -> f64 {
+        (self.row_distance(j + 0.5) - self.row_distance(j - 0.5)).abs()
+    }
+
+    /// The scales (along x, along z) of the prefilter [`mesh`] applies at distance `d` from
+    /// the camera: the grid's spacing there. It grows with the distance (along z as its
+    /// square), so a mesh of this grid holds less of the short ripples' slope far from the
+    /// camera than near it.
+    pub fn prefilter_at(&self, d: f64) -> (f64, f64) {
+        let (t_near, t_far) = (self.eye_height / self.near, self.eye_height / self.far);
+        let j = (self.eye_height / d - t_near) / (t_far - t_near) * self.rows as f64;
+        (
+            2.0 * self.half_width_per_distance * d / self.columns as f64,
+            self.row_spacing(j),
+        )
+    }
 }
 
 /// Meshes `field` on `rows` (near to far, each with `columns` intervals), every ripple
@@ -355,6 +378,51 @@ mod tests {
             let p = |i: u32| DVec3::from(m.positions[i as usize].map(f64::from));
             let n = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
             assert!(n.y > 0.0);
+        }
+    }
+
+    /// The prefilter at a row's own distance is the spacing to its neighbours: along z
+    /// half-way to each (the rows' own `dz`), along x the row's column spacing; checked
+    /// against the vertices [`mesh`] lays out.
+    #[test]
+    fn the_prefilter_at_a_rows_distance_is_its_spacing() {
+        let spec = GridSpec {
+            eye_height: 0.2,
+            eye_z: 10.0,
+            near: 0.3,
+            far: 14.0,
+            half_width_per_distance: 0.8,
+            rows: 200,
+            columns: 30,
+        };
+        let m = mesh(&RippleField::new(1, 8, 0.05), &spec);
+        let nc = spec.columns + 1;
+        let z = |j: usize| spec.eye_z - m.positions[j * nc][2] as f64;
+        for j in 1..spec.rows {
+            let (dx, dz) = spec.prefilter_at(z(j));
+            let row_dx = (m.positions[j * nc + 1][0] - m.positions[j * nc][0]) as f64;
+            let between = 0.5 * (z(j + 1) - z(j - 1));
+            assert!(
+                (dx / row_dx - 1.0).abs() < 1e-5,
+                "row {j}: {dx} vs {row_dx}"
+            );
+            // The row's own spacing, found from its distance alone (the mesh's f32 positions
+            // hold that distance to about 1e-6 m).
+            let exact = spec.prefilter_at(spec.row_distance(j as f64)).1;
+            assert!(
+                (exact / spec.row_spacing(j as f64) - 1.0).abs() < 1e-9,
+                "row {j}"
+            );
+            assert!((dz / exact - 1.0).abs() < 1e-3, "row {j}: {dz} vs {exact}");
+            // Half-way points against the neighbours' mean: equal to second order in the
+            // spacing relative to the distance (under 1 % over the nearer half).
+            if j < spec.rows / 2 {
+                assert!(
+                    (dz / between - 1.0).abs() < 0.01,
+                    "row {j}: {dz} vs {between}"
+                );
+            }
+            assert!(z(j + 1) > z(j) && dz > spec.prefilter_at(z(j - 1)).1);
         }
     }
 }

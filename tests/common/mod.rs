@@ -54,3 +54,6 @@ pub use gltf_builder::{flat_grid, paper_setup, TestScene};
 
 /// A fitted light against the sample light it stands for.
 pub mod truth;
+
+/// A scene's water flattened, and the pixels that see the water.
+pub mod water;
