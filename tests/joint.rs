@@ -921,6 +921,31 @@ fn a_light_seen_whole_is_reported_and_can_be_held() {
     assert_eq!(ignored.lights, free.lights);
 }
 
+/// Table 3's second lamp is cut by the photo's right border, and its reflections with it: its
+/// right edge is not pinned by its image, and the photo does not tell it (no sigma, or one
+/// larger than the light), while its other three edges are pinned. The fit reports it seen
+/// whole all the same, as it does the whole lamp, so a search holds both rather than
+/// descending the cut one at every evaluation (`JointOutcome::seen_whole`).
+#[test]
+fn a_lamp_the_frame_cuts_is_seen_whole_by_the_edges_the_photo_shows() {
+    let start = paper_start("table3.png");
+    let free = start.fit(|o| JointOptions { samples: 32, ..o });
+    assert_eq!(free.lights.len(), 2, "{:?}", free.lights);
+    let cut = (0..2)
+        .max_by(|&a, &b| free.lights[a].u_min.total_cmp(&free.lights[b].u_min))
+        .unwrap();
+    let u = &free.uncertainty[cut];
+    let width = free.lights[cut].u_max - free.lights[cut].u_min;
+    use streaklight::fitting::EdgeSide;
+    assert!(u.image_bound[EdgeSide::Right].is_none(), "{u:?}");
+    assert!(u.edges[EdgeSide::Right].is_none_or(|s| s > width), "{u:?}");
+    for side in [EdgeSide::Left, EdgeSide::Bottom, EdgeSide::Top] {
+        assert!(u.image_bound[side].is_some(), "{side:?}: {u:?}");
+    }
+    let rects: Vec<_> = free.lights.iter().map(|l| Some(l.rect())).collect();
+    assert_eq!(free.seen_whole, rects);
+}
+
 /// A light resumed near its optimum (`JointOptions::resume`) is descended from there, its
 /// edges searched a fraction of a pixel's footprint around it, and ends where the fit from
 /// the start ends: Table 1's light, resumed where the free fit put it and 3 cm (a footprint

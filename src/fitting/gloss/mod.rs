@@ -56,7 +56,8 @@
 //!   the estimates moved by under 2 % (Table 3 from e = 100: 502.3 instead of 511.9; the
 //!   others within 0.6 %) and an evaluation took 1.6 s instead of 3.6 s.
 //! * A light the first fit on a trace finds whole in the photo, every edge pinned by its
-//!   direct image within a pixel's footprint ([`super::joint::JointOutcome::seen_whole`]), is
+//!   direct image within a pixel's footprint or beyond what the photo tells
+//!   ([`super::joint::JointOutcome::seen_whole`]), is
 //!   held there by the later fits on that trace ([`JointOptions::held`]): its image places it
 //!   whatever the gloss, and a held fit costs the weighting and a radiance solve, not a
 //!   descent. The searches took 2.8 s instead of 4.0 s on `table1.png`, 3.4 s instead of

@@ -6,7 +6,8 @@
 //! ([`Problem::structured`]), each light is tried as two, one above the other or side by side
 //! ([`try_split`]), and the split is kept when it removes most of that structure. A light the
 //! photo shows whole (every edge pinned by its direct image within a pixel's footprint:
-//! [`Problem::image_bounds`]) is not tried: it is one lamp's image, whose direct pixels
+//! [`Problem::image_bounds`]; or, after a search, as its first fit found it:
+//! `JointOutcome::seen_whole`) is not tried: it is one lamp's image, whose direct pixels
 //! refuse a cut in half, and under the statistical model, whose residual is the glitter and
 //! always structured, its trials were most of the final fit's time. The second
 //! light of a split then reads a sample set of its own, drawn independently on the same
@@ -61,12 +62,15 @@ pub(super) fn optimise(
     let mut splits = Vec::new();
     // A light whose every edge its direct image pins (`image_bound`) is one lamp's image:
     // its reflections need no second light (lamps with images of their own start lights of
-    // their own, `lamp_starts`), so it is not tried as two.
+    // their own, `lamp_starts`), so it is not tried as two. So is one a search's first fit
+    // found whole (`held`, `resume`: its edges pinned or beyond what the photo shows).
+    let given = |rects: &[Option<Rect>], k: usize| rects.len() == start.len() && rects[k].is_some();
     let seen: Vec<bool> = if split {
         problem
             .image_bounds(&st)
             .iter()
-            .map(|b| b.iter().all(Option::is_some))
+            .enumerate()
+            .map(|(k, b)| b.iter().all(Option::is_some) || given(held, k) || given(resume, k))
             .collect()
     } else {
         Vec::new()

@@ -49,8 +49,9 @@ pub struct JointOutcome {
     /// By start light as the fit took them (after the starts are moved onto and split by the
     /// lamps' direct images): the fitted rectangle of each the photo shows whole, every edge
     /// pinned by its direct image within a pixel's footprint
-    /// ([`Uncertainty::image_bound`]), else `None`. Its image holds it there whatever the
-    /// water's lobe, so a search may too
+    /// ([`Uncertainty::image_bound`]) or not constrained by the photo at all (the frame cuts
+    /// the lamp there, and its reflections with it), else `None`. Its image holds it there
+    /// whatever the water's lobe, so a search may too
     /// ([`JointOptions::held`](super::JointOptions::held)).
     pub seen_whole: Vec<Option<Rect>>,
 }
@@ -103,9 +104,11 @@ impl JointOutcome {
     }
 }
 
-/// By start light (of `starts`): the rectangle of each light of `st` whose every edge its
-/// direct image pins within a pixel's footprint (its `uncertainty`'s `image_bound`), unless a
-/// split made two lights of it ([`JointOutcome::seen_whole`]).
+/// By start light (of `starts`): the rectangle of each light of `st` whose direct image pins
+/// it, unless a split made two lights of it ([`JointOutcome::seen_whole`]). Every edge is
+/// pinned within a pixel's footprint (its `uncertainty`'s `image_bound`) or not told by the
+/// photo (a flat cost, or a sigma larger than the light: where the frame cuts the lamp and
+/// its reflections alike), and at least one is pinned.
 pub(super) fn seen_whole(
     problem: &Problem,
     st: &State,
@@ -117,7 +120,14 @@ pub(super) fn seen_whole(
         let origin = problem.set_origin[st.set_of[k]];
         let alone =
             (0..st.rects.len()).all(|j| j == k || problem.set_origin[st.set_of[j]] != origin);
-        if alone && u.image_bound.iter().all(Option::is_some) {
+        let pinned = u.image_bound.iter().filter(|b| b.is_some()).count();
+        let r = st.rects[k];
+        let size = [r.u_max - r.u_min, r.v_max - r.v_min];
+        // An edge whose sigma exceeds the light's size along it is one the photo does not
+        // tell: the tails of a broad lobe reaching it are all that move the cost.
+        let unseen = |e: usize| u.edges[e].is_none_or(|sigma| sigma > size[e / 2]);
+        let settled = (0..4).all(|e| u.image_bound[e].is_some() || unseen(e));
+        if alone && pinned > 0 && settled {
             seen_whole[origin] = Some(st.rects[k]);
         }
     }
