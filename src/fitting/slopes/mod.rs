@@ -25,7 +25,15 @@
 //! Every fit starts from the same lights (the paper fit at the starting variances, placed on
 //! the lamps' direct images once: [`super::joint::place_starts`]), reads the
 //! same pixels (those the broadest lobe of the search can see: four times the starting
-//! variances) with the same random numbers, so the costs are comparable. A light the first
+//! variances) with the same random numbers, so the costs are comparable. The fits weigh the
+//! samples of one trace under a proposal lobe of [`PROPOSAL_OVER_START`] times the starting
+//! variances (`joint::ProposalCache`); a fit above its reach on an axis is traced under a
+//! proposal grown to [`PROPOSAL_OVER_START`] times its variance there, which the fits after
+//! it share: over a flat quad whose material is smoother than the photo's waves
+//! (`gloss1000.png`) the search left the first proposal's reach after three fits and traced
+//! each of the six after anew. A fit below its reach (the low end of a bracket) traces its
+//! own samples, as a proposal moved down to it would leave the search's later fits
+//! uncovered again. A light the first
 //! fit saw whole in the photo ([`super::joint::JointOutcome::seen_whole`]: every edge pinned
 //! by its direct image within a pixel's footprint, or beyond what the photo tells, as where
 //! the frame cuts the lamp) is pinned by it whatever the lobe, so
@@ -275,14 +283,18 @@ pub fn estimate_slopes(
     // The weights of the first fit's rows, which every later fit of the search takes.
     let search_scales: std::cell::OnceCell<Vec<f32>> = std::cell::OnceCell::new();
     // Every fit of the search the proposal covers weighs the samples of its one trace
-    // (`ProposalCache`): their costs compare as fits from one set of samples do.
-    let proposal = ProposalCache::new(Lobe::Statistical {
-        water: water_with_total(
-            surface,
-            start_variance.map(|v| (PROPOSAL_OVER_START * v).min(hi)),
-        ),
-        gloss: model.gloss,
-    });
+    // (`ProposalCache`): their costs compare as fits from one set of samples do. A fit the
+    // search takes above its reach gets a proposal grown to cover it, which the fits after
+    // it share (module doc).
+    let proposal_over = |total: [f32; 2]| {
+        ProposalCache::new(Lobe::Statistical {
+            water: water_with_total(surface, total.map(|v| v.min(hi))),
+            gloss: model.gloss,
+        })
+    };
+    let proposal = std::cell::RefCell::new(proposal_over(
+        start_variance.map(|v| PROPOSAL_OVER_START * v),
+    ));
     // The lights the first fit saw whole in the photo, by start light: every later fit holds
     // them there (module doc).
     let whole: std::cell::OnceCell<Vec<Option<Rect>>> = std::cell::OnceCell::new();
@@ -299,6 +311,18 @@ pub fn estimate_slopes(
         // Weighted as the final fit is, every fit by the first one's weights (`row_scales`).
         let weighted = final_fit.glitter_weights;
         let target = water_with_total(surface, v);
+        let lobe = Lobe::Statistical {
+            water: target,
+            gloss: model.gloss,
+        };
+        let p = proposal.borrow().proposal.variance();
+        if !proposal.borrow().covers(&lobe) && (0..2).any(|a| v[a] > p[a]) {
+            // Grown on the axes the fit is above it; the old trace is freed before the new
+            // one is made. A fit below its reach (a bracket's low end) traces its own.
+            let grown = [0, 1].map(|a| p[a].max(PROPOSAL_OVER_START * v[a]));
+            drop(proposal.replace(proposal_over(grown)));
+        }
+        let cache = proposal.borrow();
         let fit = fit_joint_with(
             &target,
             scene,
@@ -311,11 +335,8 @@ pub fn estimate_slopes(
                 row_scales: search_scales.get().map(|s| &s[..]),
                 held: whole.get().map_or(&[], |h| &h[..]),
                 reweight: Some(Reweight {
-                    cache: &proposal,
-                    target: Lobe::Statistical {
-                        water: target,
-                        gloss: model.gloss,
-                    },
+                    cache: &cache,
+                    target: lobe,
                 }),
                 ..search_options
             },
@@ -455,6 +476,7 @@ pub fn estimate_slopes(
         .get()
         .filter(|h| !h.is_empty() && h.iter().all(Option::is_some))
         .map_or(&[][..], |h| &h[..]);
+    let proposal = proposal.into_inner();
     let kept = (!resume.is_empty() && proposal.serves_traced(&target)).then_some(proposal);
     let common = JointOptions {
         model,
