@@ -361,19 +361,23 @@ mod tests {
         assert!(exact.covariance.abs() > 0.4 * s2);
     }
 
-    #[test]
-    fn triangles_face_up() {
-        let field = RippleField::new(1, 8, 0.05);
-        let spec = GridSpec {
+    /// A grid of the paper's camera with `rows` rows of 30 columns.
+    fn grid(rows: usize) -> GridSpec {
+        GridSpec {
             eye_height: 0.2,
             eye_z: 10.0,
             near: 0.3,
             far: 14.0,
             half_width_per_distance: 0.8,
-            rows: 20,
+            rows,
             columns: 30,
-        };
-        let m = mesh(&field, &spec);
+        }
+    }
+
+    #[test]
+    fn triangles_face_up() {
+        let field = RippleField::new(1, 8, 0.05);
+        let m = mesh(&field, &grid(20));
         for t in m.indices.chunks_exact(3) {
             let p = |i: u32| DVec3::from(m.positions[i as usize].map(f64::from));
             let n = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
@@ -386,15 +390,7 @@ mod tests {
     /// against the vertices [`mesh`] lays out.
     #[test]
     fn the_prefilter_at_a_rows_distance_is_its_spacing() {
-        let spec = GridSpec {
-            eye_height: 0.2,
-            eye_z: 10.0,
-            near: 0.3,
-            far: 14.0,
-            half_width_per_distance: 0.8,
-            rows: 200,
-            columns: 30,
-        };
+        let spec = grid(200);
         let m = mesh(&RippleField::new(1, 8, 0.05), &spec);
         let nc = spec.columns + 1;
         let z = |j: usize| spec.eye_z - m.positions[j * nc][2] as f64;
