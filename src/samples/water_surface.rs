@@ -183,8 +183,13 @@ impl GridSpec {
     /// The distance from the camera of (fractional) row `j`: rows are uniform in the tangent
     /// of the angle below the horizon, as image rows are.
     fn row_distance(&self, j: f64) -> f64 {
-        let (t_near, t_far) = (self.eye_height / self.near, self.eye_height / self.far);
+        let (t_near, t_far) = self.tangents();
         self.eye_height / (t_near + (t_far - t_near) * j / self.rows as f64)
+    }
+
+    /// The tangents of the angles below the horizon of the nearest and the farthest row.
+    fn tangents(&self) -> (f64, f64) {
+        (self.eye_height / self.near, self.eye_height / self.far)
     }
 
     /// The spacing along z around (fractional) row `j`.
@@ -197,7 +202,7 @@ impl GridSpec {
     /// square), so a mesh of this grid holds less of the short ripples' slope far from the
     /// camera than near it.
     pub fn prefilter_at(&self, d: f64) -> (f64, f64) {
-        let (t_near, t_far) = (self.eye_height / self.near, self.eye_height / self.far);
+        let (t_near, t_far) = self.tangents();
         let j = (self.eye_height / d - t_near) / (t_far - t_near) * self.rows as f64;
         (
             2.0 * self.half_width_per_distance * d / self.columns as f64,

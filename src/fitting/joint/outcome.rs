@@ -49,8 +49,9 @@ pub struct JointOutcome {
     /// By start light as the fit took them (after the starts are moved onto and split by the
     /// lamps' direct images): the fitted rectangle of each the photo shows whole, every edge
     /// pinned by its direct image within a pixel's footprint
-    /// ([`Uncertainty::image_bound`]) or not constrained by the photo at all (the frame cuts
-    /// the lamp there, and its reflections with it), else `None`. Its image holds it there
+    /// ([`Uncertainty::image_bound`]) or not told by the photo (a flat cost, or a sigma larger
+    /// than the light: the frame cuts the lamp there, and its reflections with it), else
+    /// `None`. Its image holds it there
     /// whatever the water's lobe, so a search may too
     /// ([`JointOptions::held`](super::JointOptions::held)).
     pub seen_whole: Vec<Option<Rect>>,
