@@ -173,6 +173,7 @@ fn close_to_the_water_the_model_is_the_mean_over_wave_fields() {
     let light = &scene.area_lights[0];
     let (w, h) = (300, 300);
     let pixels = near_water(&scene, w, h);
+    let on_water = water_pixels(&scene, w, h);
     let grid = samples::water_grid();
     let stats = water_statistics(&scene, w, h).unwrap();
     let axis = [stats.surface.along.x as f64, stats.surface.along.z as f64];
@@ -197,7 +198,6 @@ fn close_to_the_water_the_model_is_the_mean_over_wave_fields() {
         let flux = |pixels: &mut dyn Iterator<Item = usize>| {
             pixels.map(|i| image.pixels[i][0] as f64).sum::<f64>()
         };
-        let on_water = water_pixels(&scene, w, h);
         let near = flux(&mut pixels.iter().map(|&i| i as usize));
         let all = flux(&mut (0..on_water.len()).filter(|&i| on_water[i]));
         assert!(
