@@ -11,6 +11,7 @@
 mod common;
 
 use common::pipeline::{observations, sample_photo, sample_scene, water};
+use common::water::{harbour_expectation, mesh_slope_variances, streak_footprints};
 use streaklight::fitting::slopes::{water_with_total, MICROFACET_GLOSS};
 use streaklight::fitting::FittedLight;
 use streaklight::photo_in::Photo;
@@ -106,24 +107,89 @@ fn assert_layout(layout: &str, scene: &Scene, lit: &Lit) {
     }
 }
 
+/// The total slope variances (the lobe's whole, along and across the view) of the mesh harbour
+/// layout `layout`'s photo was rendered from, where its streaks lie: its shading normals'
+/// slopes over the union of the lights' footprints in the expected image
+/// ([`streak_footprints`], the pixels where a light's reflection passes 2 % of its peak,
+/// each pixel counted once), plus the photo's microfacets (gloss
+/// [`harbour::HARBOUR_GLOSS`]: 1 / (e + 2) a axis) less the statistical model's own
+/// ([`MICROFACET_GLOSS`]), since the fit's variances are the whole lobe's less those. Made
+/// once per layout.
+fn mesh_under_streaks(layout: &str) -> [f64; 2] {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    static MADE: OnceLock<Mutex<HashMap<String, [f64; 2]>>> = OnceLock::new();
+    let made = MADE.get_or_init(Default::default);
+    if let Some(v) = made.lock().unwrap().get(layout) {
+        return *v;
+    }
+    let scene = sample_scene(&format!("harbour-{layout}-truth.gltf"), None);
+    let photo = sample_photo(&format!("harbour-{layout}.png"));
+    let (w, h) = (photo.width, photo.height);
+    let pixels = streak_footprints(&scene, w, h);
+    let water = harbour_expectation(&scene, w, h);
+    let mesh = mesh_slope_variances(&scene, &water, &pixels, w, h);
+    let micro = |gloss: f64| 1.0 / (gloss + 2.0);
+    let total = mesh.map(|v| v + micro(harbour::HARBOUR_GLOSS) - micro(MICROFACET_GLOSS as f64));
+    println!(
+        "{layout}: the mesh's slope variances under the streaks {:.3e} along, {:.3e} across \
+         (the lobe's whole, less the model's microfacets)",
+        total[0], total[1]
+    );
+    made.lock().unwrap().insert(layout.to_string(), total);
+    total
+}
+
+/// The slope variances the fit `lit` of harbour layout `layout`'s photo (lamps in frame)
+/// estimated, against [`mesh_under_streaks`]: each within 15 %, or, where the photo tells it
+/// less well than that, within 2 of its reported sigmas (a sigma of the logarithm). Across
+/// the view a slope turns a reflection sideways by only twice the sine of the grazing angle
+/// (3 degrees at 40 m from a camera 2 m above the water), so the streaks' widths are mostly
+/// the lights' own and the variance across is told weakly: measured (over the other waves,
+/// over the flat quad; mesh 3.15e-3 along and 2.25e-3 across for the pair, 4.29e-3 and
+/// 1.81e-3 for the sign, 4.06e-3 and 2.16e-3 for the three lights) along -6.1 / -6.4 % for
+/// the pair, -14.4 / -14.9 % for the sign, -1.7 / +2.5 % for the three lights; across the
+/// pair +13.9 % / +19.1 % (sigma 14 %), the sign +25.1 % (sigma 23 %) / -14.7 %, the three
+/// lights -6.0 / -10.7 %. A variance's sigma taken from fits on two traces (the old points
+/// of a search compared with new ones after its proposal grew) came out 2.9 % for the
+/// pair's across over the other waves, at +17.5 %: this fails there.
+fn assert_slopes(layout: &str, lit: &Lit) {
+    let mesh = mesh_under_streaks(layout);
+    let slopes = lit.water_model.slopes.as_ref().unwrap();
+    for (axis, name) in ["along", "across"].into_iter().enumerate() {
+        let ratio = slopes.variance[axis] as f64 / mesh[axis];
+        let sigma = slopes.sigma_ln[axis].map_or(0.0, |s| s as f64);
+        assert!(
+            (ratio - 1.0).abs() < 0.15 || ratio.ln().abs() < 2.0 * sigma,
+            "{layout}: slope variance {name} {:.3e} against the mesh's {:.3e} under the \
+             streaks ({:+.1} %, sigma of its logarithm {sigma:.3})",
+            slopes.variance[axis],
+            mesh[axis],
+            100.0 * (ratio - 1.0)
+        );
+    }
+}
+
 /// [`assert_layout`] of the pair.
 fn assert_pair(scene: &Scene, lit: &Lit) {
     assert_layout("pair", scene, lit);
 }
 
 /// `fit` at the defaults of harbour layout `layout`'s photo with its lamps in frame against
-/// sample scene `scene`: the statistical model, chosen by the photo, and the lights as
-/// [`assert_layout`] holds them.
+/// sample scene `scene`: the statistical model, chosen by the photo, the lights as
+/// [`assert_layout`] holds them, and the slope variances as [`assert_slopes`] does.
 fn statistical_in_frame(scene: &str, layout: &str) {
-    statistical_fit(
+    let (_, lit) = statistical_fit(
         scene,
         &sample_photo(&format!("harbour-{layout}.png")),
         layout,
     );
+    assert_slopes(layout, &lit);
 }
 
 /// `fit` at the defaults of `photo`, a photo of harbour layout `layout`, against sample scene
-/// `scene`, held as [`statistical_in_frame`] holds it; returns the scene and the fit.
+/// `scene`: the statistical model, chosen by the photo, and the lights as [`assert_layout`]
+/// holds them; returns the scene and the fit.
 fn statistical_fit(scene: &str, photo: &Photo, layout: &str) -> (Scene, Lit) {
     let fitting = sample_scene(scene, None);
     let lit = pipeline::fit(
@@ -210,6 +276,7 @@ fn other_waves_take_the_statistical_model() {
     assert!(used.slopes.as_ref().unwrap().estimated);
     assert_eq!(used.slopes.as_ref().unwrap().start_samples, 128);
     assert_pair(&scene, &lit);
+    assert_slopes("pair", &lit);
 }
 
 /// With the gloss searched as well (`--gloss auto`), the exact model's gloss search takes

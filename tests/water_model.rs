@@ -7,12 +7,13 @@ mod common;
 
 use common::pipeline::{sample_photo, sample_scene};
 use common::truth::{assert_within_sigmas, nearest};
-use common::water::{flattened, water_pixels};
+use common::water::{
+    flattened, footprint, harbour_expectation, mesh_slope_variances, water_pixels,
+};
 use streaklight::pipeline::{self, FitSettings, WaterChoice};
 use streaklight::progress::Reporter;
 use streaklight::report::light_report;
 use streaklight::samples;
-use streaklight::scene_in::Scene;
 use streaklight::water_model::water_statistics;
 
 /// The settings with the water model chosen from the photo.
@@ -20,24 +21,6 @@ fn auto() -> FitSettings {
     FitSettings {
         water: WaterChoice::Auto,
         ..FitSettings::default()
-    }
-}
-
-/// The statistical water over `scene`'s mean plane with the harbour waves' own slope
-/// variances (the spectrum the harbour samples' meshes are drawn from), for a `w` x `h`
-/// image.
-fn harbour_expectation(
-    scene: &Scene,
-    w: u32,
-    h: u32,
-) -> streaklight::water_model::StatisticalSurface {
-    let spectrum = streaklight::samples::harbour_waves::harbour_spectrum();
-    streaklight::water_model::StatisticalSurface {
-        surface: water_statistics(scene, w, h).unwrap().surface,
-        waves: [
-            spectrum.rms_slope_along.powi(2) as f32,
-            spectrum.rms_slope_across.powi(2) as f32,
-        ],
     }
 }
 
@@ -242,7 +225,7 @@ fn a_small_flat_scene_at_the_defaults() {
 /// between them.
 #[test]
 fn the_expected_image_holds_the_photos_flux_and_centroids() {
-    use streaklight::render::{camera_hit, render, CameraHit, RenderOptions};
+    use streaklight::render::{render, RenderOptions};
 
     let scene = sample_scene("harbour-pair-above-truth.gltf", None);
     let photo = sample_photo("harbour-pair-above.png");
@@ -295,41 +278,13 @@ fn the_expected_image_holds_the_photos_flux_and_centroids() {
     assert!(lengths[0].abs() < 0.1, "orange length {:+.3}", lengths[0]);
     assert!(lengths[1] > 0.15, "blue length {:+.3}", lengths[1]);
     // The mesh's slope variances (along, across the view) over each streak's footprint.
-    let (n0, along, across) = (
-        water.surface.normal,
-        water.surface.along,
-        water.surface.across(),
-    );
     let mut under = Vec::new();
     for (name, ch, columns) in [("orange", 0, 0..w / 2), ("blue", 2, w / 2..w)] {
         let in_half = |i: usize| columns.contains(&(i as u32 % w));
-        let peak = (0..model.pixels.len())
-            .filter(|&i| in_half(i))
-            .map(|i| model.pixels[i][ch])
-            .fold(0f32, f32::max);
-        let (mut n, mut s, mut s2) = (0f64, [0f64; 2], [0f64; 2]);
-        for i in (0..model.pixels.len()).filter(|&i| in_half(i)) {
-            if model.pixels[i][ch] < 0.02 * peak {
-                continue;
-            }
-            for k in 0..4u32 {
-                let x = (i as u32 % w) as f32 + 0.25 + 0.5 * (k % 2) as f32;
-                let y = (i as u32 / w) as f32 + 0.25 + 0.5 * (k / 2) as f32;
-                if let CameraHit::Water(p) = camera_hit(&scene, &[], x, y, w, h) {
-                    let m = p.normal;
-                    for (a, axis) in [along, across].into_iter().enumerate() {
-                        let slope = -(m.dot(axis) / m.dot(n0)) as f64;
-                        s[a] += slope;
-                        s2[a] += slope * slope;
-                    }
-                    n += 1.0;
-                }
-            }
-        }
-        let var = [0, 1].map(|a| s2[a] / n - (s[a] / n).powi(2));
+        let pixels = footprint(&model.pixels, in_half, |p| p[ch], 0.02);
+        let var = mesh_slope_variances(&scene, &water, &pixels, w, h);
         println!(
-            "{name}: the mesh's slope variances under the streak {:.2e} along, {:.2e} across \
-             ({n} rays)",
+            "{name}: the mesh's slope variances under the streak {:.2e} along, {:.2e} across",
             var[0], var[1]
         );
         under.push(var);

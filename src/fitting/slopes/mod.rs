@@ -31,9 +31,13 @@
 //! proposal grown to [`PROPOSAL_OVER_START`] times its variance there, which the fits after
 //! it share: over a flat quad whose material is smoother than the photo's waves
 //! (`gloss1000.png`) the search left the first proposal's reach after three fits and traced
-//! each of the six after anew. A fit below its reach (the low end of a bracket) traces its
-//! own samples, as a proposal moved down to it would leave the search's later fits
-//! uncovered again. A light the first
+//! each of the six after anew. The pass's fits on the old trace are then made again on the
+//! new one ([`Pass`], the search's rebase; the grown proposal still covers the pass's
+//! lowest fit where it can), so that its parabola, and the variance's sigma
+//! from its curvature, compare fits of one trace: the harbour pair's across pass over the
+//! other waves, which mixed them, had a sigma of 2.9 % where its fits on one trace give
+//! 14 %. A fit below its reach (the low end of a bracket) traces its own samples, as a
+//! proposal moved down to it would leave the search's later fits uncovered again. A light the first
 //! fit saw whole in the photo ([`super::joint::JointOutcome::seen_whole`]: every edge pinned
 //! by its direct image within a pixel's footprint, or beyond what the photo tells, as where
 //! the frame cuts the lamp) is pinned by it whatever the lobe, so
@@ -56,11 +60,13 @@
 //! "Uncertainty"), and the lights' with the glitter's correlation and the slopes' own
 //! uncertainty carried in (`uncertainty`).
 
+mod fits;
 mod newton;
 mod uncertainty;
 
 use std::time::Instant;
 
+use fits::{last_on, Fit, Fits, Pass};
 use newton::newton_along;
 
 pub use uncertainty::{
@@ -71,7 +77,7 @@ use super::gloss::search::{search, Point, Stop};
 use super::gloss::{placed_search_start, GlossSearch};
 use super::joint::{
     fit_joint_with, start_estimate, JointOptions, Lobe, PixelShare, ProposalCache, Reweight, Split,
-    StartEstimate, Uncertainty,
+    StartEstimate, Uncertainty, TARGET_OVER_PROPOSAL,
 };
 use super::{
     FitOptions, FitOutcome, FittedLight, PaperEstimates, Rect, Skipped, StreakObservation,
@@ -272,11 +278,11 @@ pub fn estimate_slopes(
     // Each axis's last pass: (ln variance, the lights fitted there).
     let mut passes: [Vec<(f64, Vec<FittedLight>)>; 2] = [Vec::new(), Vec::new()];
     let mut variance = start_variance;
-    // Every fit made so far, in order, by its variances (the evaluations reported), and the
-    // one of lowest cost: each pass after the first searches from there (its axis's estimate
-    // lies within the tolerance of it), so the middle of its first three points is a fit
-    // already made, read again rather than made again.
-    let mut made: Vec<([f32; 2], Point, Vec<FittedLight>)> = Vec::new();
+    // Every fit made so far (the evaluations reported), and the one of lowest cost: each
+    // pass after the first searches from there (its axis's estimate lies within the
+    // tolerance of it), so the middle of its first three points is a fit already made, read
+    // again rather than made again (on the present proposal's trace).
+    let mut made = Fits::default();
     let mut anchor = start_variance;
     let mut sigma_ln = [None, None];
     let t = Instant::now();
@@ -295,6 +301,30 @@ pub fn estimate_slopes(
     let proposal = std::cell::RefCell::new(proposal_over(
         start_variance.map(|v| PROPOSAL_OVER_START * v),
     ));
+    // How many times the proposal has grown: the fits on one generation compare.
+    let generation = std::cell::Cell::new(0u32);
+    // Whether a fit at `v` lies above the proposal's reach on some axis, where the proposal
+    // grows to it rather than the fit tracing its own samples.
+    let above_reach = |v: [f32; 2]| {
+        let lobe = Lobe::Statistical {
+            water: water_with_total(surface, v),
+            gloss: model.gloss,
+        };
+        let cache = proposal.borrow();
+        let p = cache.proposal.variance();
+        !cache.covers(&lobe) && (0..2).any(|a| v[a] > p[a])
+    };
+    // Grows the proposal to [`PROPOSAL_OVER_START`] times `v`, but on each axis no higher
+    // than still covers `keep` (the lowest variance of the fits to be made again on it) and
+    // no lower than `v`; the old trace is freed before the new one is made.
+    let grow_to = |v: [f32; 2], keep: [f32; 2]| {
+        let p = proposal.borrow().proposal.variance();
+        let reach = TARGET_OVER_PROPOSAL.0;
+        let grown =
+            [0, 1].map(|a| p[a].max((PROPOSAL_OVER_START * v[a]).min(keep[a] / reach).max(v[a])));
+        drop(proposal.replace(proposal_over(grown)));
+        generation.set(generation.get() + 1);
+    };
     // The lights the first fit saw whole in the photo, by start light: every later fit holds
     // them there (module doc).
     let whole: std::cell::OnceCell<Vec<Option<Rect>>> = std::cell::OnceCell::new();
@@ -302,8 +332,9 @@ pub fn estimate_slopes(
     // final fit reads the same share, so that the residual's correlation area it measures
     // grows the search's curvature over the pixels that made it.
     let search_share: std::cell::OnceCell<PixelShare> = std::cell::OnceCell::new();
-    // The `number`-th fit, at variances `v`.
-    let eval = |v: [f32; 2], number: usize| -> Result<(Point, Vec<FittedLight>)> {
+    // The `number`-th fit, at variances `v`, with the generation of the proposal it weighed
+    // (`None`: it traced its own samples).
+    let eval = |v: [f32; 2], number: usize| -> Result<Fit> {
         final_fit.progress.stage(&format!(
             "slope search: joint fit {number} at variances {:.2e} along, {:.2e} across",
             v[0], v[1]
@@ -315,14 +346,12 @@ pub fn estimate_slopes(
             water: target,
             gloss: model.gloss,
         };
-        let p = proposal.borrow().proposal.variance();
-        if !proposal.borrow().covers(&lobe) && (0..2).any(|a| v[a] > p[a]) {
-            // Grown on the axes the fit is above it; the old trace is freed before the new
-            // one is made. A fit below its reach (a bracket's low end) traces its own.
-            let grown = [0, 1].map(|a| p[a].max(PROPOSAL_OVER_START * v[a]));
-            drop(proposal.replace(proposal_over(grown)));
+        if above_reach(v) {
+            // A fit below its reach (a bracket's low end) traces its own.
+            grow_to(v, [f32::INFINITY; 2]);
         }
         let cache = proposal.borrow();
+        let basis = cache.covers(&lobe).then(|| generation.get());
         let fit = fit_joint_with(
             &target,
             scene,
@@ -362,6 +391,7 @@ pub fn estimate_slopes(
                 variance: fit.residual_variance,
             },
             fit.lights,
+            basis,
         ))
     };
     let (lo_ln, hi_ln) = ((lo as f64).ln(), (hi as f64).ln());
@@ -376,48 +406,52 @@ pub fn estimate_slopes(
             }
         }
         let name = ["slope variance along", "slope variance across"][axis];
-        // The fit at variances `v`, made again only if not made yet.
-        let mut point_at = |v: [f32; 2]| -> Result<(Point, Vec<FittedLight>)> {
-            // The same variances to rounding (the logarithm and back).
-            let same = |m: &[f32; 2]| (0..2).all(|a| (m[a] / v[a] - 1.0).abs() < 1e-6);
-            Ok(match made.iter().find(|m| same(&m.0)) {
-                Some((_, p, lights)) => (*p, lights.clone()),
-                None => {
-                    let (p, lights) = eval(v, made.len() + 1)?;
-                    made.push((v, p, lights.clone()));
-                    (p, lights)
-                }
-            })
-        };
+        // The fit at variances `v`, made again only if not made yet on the present trace.
+        let mut made_at = |v: [f32; 2]| made.at(v, generation.get(), eval);
         if pass == 2 {
+            let mut point_at = |v: [f32; 2]| made_at(v).map(|(p, lights, _)| (p, lights));
             if let Some(v) = newton_along(&mut point_at, anchor, along_curvature, options)? {
                 variance[0] = v;
                 continue;
             }
         }
-        let pass_points = &mut passes[axis];
-        pass_points.clear();
+        let at = |x: f64| {
+            let mut v = anchor;
+            v[axis] = x.exp() as f32;
+            v
+        };
+        // The pass's fits: (ln variance, lights, proposal generation); and the lowest
+        // variance of those on the present proposal, which a proposal grown for the pass
+        // covers still, so that they are made again on its trace rather than each on its own.
+        let mut pass_points = Vec::new();
+        let lowest = std::cell::Cell::new(f32::INFINITY);
         let found = search(
             options,
             (anchor[axis] as f64).ln(),
             (lo_ln, hi_ln),
             (name, show),
-            |x: f64| {
-                let mut v = anchor;
-                v[axis] = x.exp() as f32;
-                let (p, lights) = point_at(v)?;
-                if p.s.is_finite() {
-                    pass_points.push((x, lights));
-                }
-                Ok(Point { x, ..p })
+            Pass {
+                point: |x: f64| {
+                    let (p, lights, basis) = made_at(at(x))?;
+                    if basis.is_some() {
+                        lowest.set(lowest.get().min(at(x)[axis]));
+                    }
+                    if p.s.is_finite() {
+                        pass_points.push((x, lights, basis));
+                    }
+                    Ok(Point { x, ..p })
+                },
+                serves: |x: f64| !above_reach(at(x)),
+                rebase: |next: f64| {
+                    let mut keep = [f32::INFINITY; 2];
+                    keep[axis] = lowest.replace(f32::INFINITY);
+                    grow_to(at(next), keep)
+                },
             },
         )?;
+        passes[axis] = last_on(pass_points, generation.get());
         variance[axis] = found.x.exp() as f32;
-        if let Some(best) = made
-            .iter()
-            .filter(|m| m.1.s.is_finite())
-            .min_by(|a, b| a.1.s.total_cmp(&b.1.s))
-        {
+        if let Some(best) = made.best(generation.get()) {
             anchor = best.0;
             if pass == 0 {
                 // The curvature of the along pass's parabola, from its sigma and its best
@@ -442,7 +476,7 @@ pub fn estimate_slopes(
             )),
         }
     }
-    let evaluations: Vec<([f32; 2], f64)> = made.iter().map(|m| (m.0, m.1.s)).collect();
+    let evaluations = made.evaluations();
     timings.push((
         format!("slope search ({} evaluations)", evaluations.len()),
         t.elapsed().as_secs_f64(),

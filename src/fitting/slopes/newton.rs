@@ -27,8 +27,10 @@ pub(super) fn newton_along(
     if x0 + h > (hi as f64).ln() {
         return Ok(None);
     }
-    let (p0, _) = point_at(anchor)?;
+    // The step above first: where it grows the search's proposal, the anchor's fit is then
+    // made again on the new trace, and the two compare.
     let (p1, _) = point_at([(x0 + h).exp() as f32, anchor[1]])?;
+    let (p0, _) = point_at(anchor)?;
     if !(p0.s.is_finite() && p1.s.is_finite()) {
         return Ok(None);
     }
