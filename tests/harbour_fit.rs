@@ -400,7 +400,7 @@ fn the_sign_over_other_waves_and_a_flat_quad() {
 /// The sign over the wave field of seed 13 of `cargo bench --bench realisations`, the field
 /// of sixteen whose reflections hold the least of the sign's light: rendered as the sample
 /// photos are and fitted against the flat quad at the defaults, the sign comes out one light
-/// with its edges from its image, and its radiance, which only the reflections give, 19.8 %
+/// with its edges from its image, and its radiance, which only the reflections give, 20.0 %
 /// low (measured). That is one realisation of the waves, not something the fit can see, so
 /// its sigma must cover it: within 3 sigmas at the realisations' floor of 10 % of the
 /// radiance fitted (2.5 sigmas; 4.9 at a floor of 5 %). The report's warning says what would

@@ -88,9 +88,9 @@ pub fn correlation_area(
 /// the whole streak's light by the radiance (docs/decisions.md). Measured by `cargo bench
 /// --bench realisations` (BENCHMARKS.md): the harbour's sign, its image clipped in every
 /// channel, rendered over 16 wave fields of the harbour's statistics and fitted against the
-/// flat quad, came out 7.8 % rms off (from 19.8 % low to 12.3 % high, mean -1.3 %); Table 1's
+/// flat quad, came out 7.8 % rms off (from 20.0 % low to 11.3 % high, mean -1.6 %); Table 1's
 /// lamp, close to the water, 5.2 % low on average with 1.9 % of scatter. 10 % covers both as
-/// one sigma: the largest, 19.8 % low, is 2.5 sigmas of the radiance it was fitted at.
+/// one sigma: the largest, 20.0 % low, is 2.5 sigmas of the radiance it was fitted at.
 pub const REALISATION_FLUX: f64 = 0.10;
 
 /// Every radiance sigma of a light whose radiance the reflections alone give (not
