@@ -9,7 +9,11 @@
 //! quad, so what scatters is the waves, not the scene. Per seed it prints the brightest
 //! channel's radiance error (% of the truth) and that error in reported sigmas, then their
 //! root mean square, mean and largest, and how many seeds' fits gave more lights than the
-//! truth holds.
+//! truth holds. For the harbour's sign it also holds the fit's slope variances against the
+//! ones of that realisation's mesh under the sign's streak
+//! ([`streaklight::samples::streak_slopes::lobe_under_streaks`]): per axis the error in %
+//! and in reported sigmas, then their root mean square, mean and largest, and how many lie
+//! within 15 %.
 //!
 //! `cargo bench --bench realisations` runs 16 seeds of the harbour's warm white sign (6 x
 //! 1.2 m, 40 m from a camera 2 m above the water, its image clipped in every channel) and of
@@ -21,9 +25,12 @@
 use std::path::{Path, PathBuf};
 
 use streaklight::convert::{convert, ConvertOptions};
+use streaklight::fitting::slopes::MICROFACET_GLOSS;
 use streaklight::pipeline::FitSettings;
 use streaklight::render::{render, RenderOptions};
+use streaklight::samples::harbour::HARBOUR_GLOSS;
 use streaklight::samples::realisation::write_over_waves;
+use streaklight::samples::streak_slopes::lobe_under_streaks;
 use streaklight::samples::{self, SampleLight, PHOTO_EXPOSURE, PHOTO_SIZE};
 
 /// One case: the truth scene rendered, the scene fitted against, and the truth lights.
@@ -91,8 +98,27 @@ fn main() {
         let mut zs: Vec<Vec<f64>> = vec![Vec::new(); case.lights.len()];
         // Seeds whose fit gave more lights than the truth holds.
         let mut extra = 0;
+        // Per axis (along, across the view), each seed's slope variance error: ln(fitted /
+        // mesh's) and that in reported sigmas.
+        let mut slope_errors: [Vec<(f64, Option<f64>)>; 2] = [Vec::new(), Vec::new()];
         for seed in 1..=seeds {
-            let lights = fit_realisation(&dir, &case, seed, spp);
+            let Fitted { lights, slopes } = fit_realisation(&dir, &case, seed, spp);
+            if let Some(s) = slopes {
+                let mut line = format!("{} seed {seed}: slope variances", case.name);
+                for (axis, name) in ["along", "across"].into_iter().enumerate() {
+                    let ln = (s.fitted[axis] / s.mesh[axis]).ln();
+                    let z = s.sigma_ln[axis].map(|sigma| ln / sigma);
+                    line += &format!(
+                        " {name} {:.2e} against the mesh's {:.2e} ({:+.1} %, {} sigmas)",
+                        s.fitted[axis],
+                        s.mesh[axis],
+                        100.0 * ln.exp_m1(),
+                        z.map_or("-".into(), |z| format!("{z:+.1}"))
+                    );
+                    slope_errors[axis].push((ln, z));
+                }
+                println!("{line}");
+            }
             if lights.len() > case.lights.len() {
                 extra += 1;
             }
@@ -140,22 +166,54 @@ fn main() {
                 z.len()
             );
         }
+        for (axis, name) in ["along", "across"].into_iter().enumerate() {
+            let errors = &slope_errors[axis];
+            if errors.is_empty() {
+                continue;
+            }
+            let e: Vec<f64> = errors.iter().map(|x| 100.0 * x.0.exp_m1()).collect();
+            let z: Vec<f64> = errors.iter().filter_map(|x| x.1).collect();
+            println!(
+                "| {} | slope variance {name} | {} | {:.1} | {:+.1} | {:.1} | {}/{} | {:.1} | {:.1} |",
+                case.name,
+                e.len(),
+                rms(&e),
+                e.iter().sum::<f64>() / e.len() as f64,
+                e.iter().map(|x| x.abs()).fold(0.0, f64::max),
+                e.iter().filter(|x| x.abs() < 15.0).count(),
+                e.len(),
+                rms(&z),
+                z.iter().map(|x| x.abs()).fold(0.0, f64::max),
+            );
+        }
     }
     println!(
         "(columns: case | light | seeds | rms error % | mean % | largest % | rms sigmas | \
-         largest sigmas | within 3 sigmas | seeds with more lights than the truth)"
+         largest sigmas | within 3 sigmas | seeds with more lights than the truth; for a slope \
+         variance: case | axis | seeds | rms error % | mean % | largest % | within 15 % | rms \
+         sigmas | largest sigmas)"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A realisation's fit: the report's lights, and at the harbour its slope variances.
+struct Fitted {
+    lights: Vec<streaklight::report::LightReport>,
+    slopes: Option<Slopes>,
+}
+
+/// The fit's slope variances (along, across the view) with the sigmas of their logarithms,
+/// and the realisation's mesh's under the streaks.
+struct Slopes {
+    fitted: [f64; 2],
+    sigma_ln: [Option<f64>; 2],
+    mesh: [f64; 2],
+}
+
 /// Renders `case`'s truth over the waves of `seed` as the sample photos are, fits the photo
-/// against the case's flat quad at the defaults, and returns the report's lights.
-fn fit_realisation(
-    dir: &Path,
-    case: &Case,
-    seed: u64,
-    spp: u32,
-) -> Vec<streaklight::report::LightReport> {
+/// against the case's flat quad at the defaults, and returns the report's lights and, for the
+/// harbour's sign, its slope variances against the realisation's mesh's.
+fn fit_realisation(dir: &Path, case: &Case, seed: u64, spp: u32) -> Fitted {
     let here = dir.join(format!("{}-{seed}", case.name));
     let truth = write_over_waves(case.truth, seed, &here).expect("writing the truth's scene");
     let scene = streaklight::scene_in::load(&truth, &Default::default())
@@ -180,9 +238,27 @@ fn fit_realisation(
         fit: FitSettings::default(),
         ..ConvertOptions::new(dir.join(case.fitted_against), &photo, here.join("lit.gltf"))
     };
-    let lights = convert(&options).expect("fit").report.lights;
+    let report = convert(&options).expect("fit").report;
+    let slopes = (case.name == "sign")
+        .then_some(report.water_model.slopes.as_ref())
+        .flatten()
+        .map(|s| Slopes {
+            fitted: s.variance.map(f64::from),
+            sigma_ln: s.sigma_ln.map(|x| x.map(f64::from)),
+            mesh: lobe_under_streaks(
+                &scene,
+                PHOTO_SIZE,
+                PHOTO_SIZE,
+                HARBOUR_GLOSS,
+                MICROFACET_GLOSS as f64,
+            )
+            .expect("the mesh's slopes under the streaks"),
+        });
     let _ = std::fs::remove_dir_all(&here);
-    lights
+    Fitted {
+        lights: report.lights,
+        slopes,
+    }
 }
 
 fn distance(light: &streaklight::report::LightReport, truth: &SampleLight) -> f64 {

@@ -13,12 +13,13 @@
 mod common;
 
 use common::pipeline::{sample_photo, sample_scene};
-use common::water::{flattened, water_pixels};
+use common::water::flattened;
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 use streaklight::optics::ReflectionModel;
 use streaklight::random::Rng;
 use streaklight::render::{render_with_lights, RenderOptions};
+use streaklight::samples::streak_slopes::water_pixels;
 use streaklight::samples::{self, ripples_of, water_surface::GridSpec, water_surface::RippleField};
 use streaklight::scene_in::{AreaLight, Scene};
 use streaklight::water_model::{water_statistics, StatisticalSurface, WaterModel};

@@ -11,13 +11,13 @@
 mod common;
 
 use common::pipeline::{observations, sample_photo, sample_scene, water};
-use common::water::{harbour_expectation, mesh_slope_variances, streak_footprints};
-use streaklight::fitting::slopes::{water_with_total, MICROFACET_GLOSS};
+use streaklight::fitting::slopes::{water_with_total, MICROFACET_GLOSS, SLOPE_REALISATION_LN};
 use streaklight::fitting::FittedLight;
 use streaklight::photo_in::Photo;
 use streaklight::pipeline::{self, FitSettings, Lit};
 use streaklight::progress::Reporter;
 use streaklight::render::{render_with_lights, RenderOptions};
+use streaklight::samples::streak_slopes::lobe_under_streaks;
 use streaklight::samples::{self, harbour};
 use streaklight::scene_in::Scene;
 use streaklight::water_model::water_statistics;
@@ -108,10 +108,9 @@ fn assert_layout(layout: &str, scene: &Scene, lit: &Lit) {
 }
 
 /// The total slope variances (the lobe's whole, along and across the view) of the mesh harbour
-/// layout `layout`'s photo was rendered from, where its streaks lie: its shading normals'
-/// slopes over the union of the lights' footprints in the expected image
-/// ([`streak_footprints`], the pixels where a light's reflection passes 2 % of its peak,
-/// each pixel counted once), plus the photo's microfacets (gloss
+/// layout `layout`'s photo was rendered from, where its streaks lie ([`lobe_under_streaks`]:
+/// its shading normals' slopes over the union of the lights' footprints in the expected
+/// image, each pixel counted once), plus the photo's microfacets (gloss
 /// [`harbour::HARBOUR_GLOSS`]: 1 / (e + 2) a axis) less the statistical model's own
 /// ([`MICROFACET_GLOSS`]), since the fit's variances are the whole lobe's less those. Made
 /// once per layout.
@@ -125,12 +124,14 @@ fn mesh_under_streaks(layout: &str) -> [f64; 2] {
     }
     let scene = sample_scene(&format!("harbour-{layout}-truth.gltf"), None);
     let photo = sample_photo(&format!("harbour-{layout}.png"));
-    let (w, h) = (photo.width, photo.height);
-    let pixels = streak_footprints(&scene, w, h);
-    let water = harbour_expectation(&scene, w, h);
-    let mesh = mesh_slope_variances(&scene, &water, &pixels, w, h);
-    let micro = |gloss: f64| 1.0 / (gloss + 2.0);
-    let total = mesh.map(|v| v + micro(harbour::HARBOUR_GLOSS) - micro(MICROFACET_GLOSS as f64));
+    let total = lobe_under_streaks(
+        &scene,
+        photo.width,
+        photo.height,
+        harbour::HARBOUR_GLOSS,
+        MICROFACET_GLOSS as f64,
+    )
+    .unwrap();
     println!(
         "{layout}: the mesh's slope variances under the streaks {:.3e} along, {:.3e} across \
          (the lobe's whole, less the model's microfacets)",
@@ -141,26 +142,25 @@ fn mesh_under_streaks(layout: &str) -> [f64; 2] {
 }
 
 /// The slope variances the fit `lit` of harbour layout `layout`'s photo (lamps in frame)
-/// estimated, against [`mesh_under_streaks`]: each within 15 %, or, where the photo tells it
-/// less well than that, within 2 of its reported sigmas (a sigma of the logarithm). Across
-/// the view a slope turns a reflection sideways by only twice the sine of the grazing angle
-/// (3 degrees at 40 m from a camera 2 m above the water), so the streaks' widths are mostly
-/// the lights' own and the variance across is told weakly: measured (over the other waves,
-/// over the flat quad; mesh 3.15e-3 along and 2.25e-3 across for the pair, 4.29e-3 and
-/// 1.81e-3 for the sign, 4.06e-3 and 2.16e-3 for the three lights) along -6.1 / -6.4 % for
-/// the pair, -14.4 / -14.9 % for the sign, -1.7 / +2.5 % for the three lights; across the
-/// pair +13.9 % / +19.1 % (sigma 14 %), the sign +25.1 % (sigma 23 %) / -14.7 %, the three
-/// lights -6.0 / -10.7 %. A variance's sigma taken from fits on two traces (the old points
-/// of a search compared with new ones after its proposal grew) came out 2.9 % for the
-/// pair's across over the other waves, at +17.5 %: this fails there.
+/// estimated, against [`mesh_under_streaks`]: along the view within 15 %; across within 15 %
+/// or within its reported sigma (at least [`SLOPE_REALISATION_LN`], 0.43 in the logarithm:
+/// over 16 realisations of the sign's waves the estimate across was that far off, rms).
+/// Across the view a slope turns a reflection sideways by only twice the sine of the grazing
+/// angle (3 degrees at 40 m from a camera 2 m above the water), so the streaks' widths are
+/// mostly the lights' own and the variance across is told weakly. Measured (over the other
+/// waves, over the flat quad; mesh 3.15e-3 along and 2.25e-3 across for the pair, 4.29e-3
+/// and 1.81e-3 for the sign, 4.06e-3 and 2.16e-3 for the three lights): along -6.1 / -6.4 %
+/// for the pair, -14.4 / -14.9 % for the sign, -1.7 / +2.5 % for the three lights; across
+/// the pair +13.9 % / +19.1 %, the sign +25.1 % / -14.7 %, the three lights -6.0 / -10.7 %.
 fn assert_slopes(layout: &str, lit: &Lit) {
     let mesh = mesh_under_streaks(layout);
     let slopes = lit.water_model.slopes.as_ref().unwrap();
     for (axis, name) in ["along", "across"].into_iter().enumerate() {
         let ratio = slopes.variance[axis] as f64 / mesh[axis];
         let sigma = slopes.sigma_ln[axis].map_or(0.0, |s| s as f64);
+        let within = (ratio - 1.0).abs() < 0.15 || (axis == 1 && ratio.ln().abs() < sigma);
         assert!(
-            (ratio - 1.0).abs() < 0.15 || ratio.ln().abs() < 2.0 * sigma,
+            within,
             "{layout}: slope variance {name} {:.3e} against the mesh's {:.3e} under the \
              streaks ({:+.1} %, sigma of its logarithm {sigma:.3})",
             slopes.variance[axis],
@@ -168,6 +168,10 @@ fn assert_slopes(layout: &str, lit: &Lit) {
             100.0 * (ratio - 1.0)
         );
     }
+    assert!(
+        (0..2).all(|a| slopes.sigma_ln[a].is_some_and(|s| s >= SLOPE_REALISATION_LN[a])),
+        "{slopes:?}"
+    );
 }
 
 /// [`assert_layout`] of the pair.

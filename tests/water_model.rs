@@ -7,13 +7,14 @@ mod common;
 
 use common::pipeline::{sample_photo, sample_scene};
 use common::truth::{assert_within_sigmas, nearest};
-use common::water::{
-    flattened, footprint, harbour_expectation, mesh_slope_variances, water_pixels,
-};
+use common::water::flattened;
 use streaklight::pipeline::{self, FitSettings, WaterChoice};
 use streaklight::progress::Reporter;
 use streaklight::report::light_report;
 use streaklight::samples;
+use streaklight::samples::streak_slopes::{
+    footprint, harbour_expectation, mesh_slope_variances, water_pixels,
+};
 use streaklight::water_model::water_statistics;
 
 /// The settings with the water model chosen from the photo.
@@ -230,7 +231,7 @@ fn the_expected_image_holds_the_photos_flux_and_centroids() {
     let scene = sample_scene("harbour-pair-above-truth.gltf", None);
     let photo = sample_photo("harbour-pair-above.png");
     let (w, h) = (photo.width, photo.height);
-    let water = harbour_expectation(&scene, w, h);
+    let water = harbour_expectation(&scene, w, h).unwrap();
     let model = render(
         &scene,
         &RenderOptions {
@@ -282,7 +283,7 @@ fn the_expected_image_holds_the_photos_flux_and_centroids() {
     for (name, ch, columns) in [("orange", 0, 0..w / 2), ("blue", 2, w / 2..w)] {
         let in_half = |i: usize| columns.contains(&(i as u32 % w));
         let pixels = footprint(&model.pixels, in_half, |p| p[ch], 0.02);
-        let var = mesh_slope_variances(&scene, &water, &pixels, w, h);
+        let var = mesh_slope_variances(&scene, &water, &pixels, w, h).unwrap();
         println!(
             "{name}: the mesh's slope variances under the streak {:.2e} along, {:.2e} across",
             var[0], var[1]
@@ -377,7 +378,7 @@ fn the_signs_photo_holds_less_light_than_its_expectation() {
             .map(|(p, _)| (p[0] + p[1] + p[2]) as f64)
             .sum()
     };
-    let water = harbour_expectation(&scene, w, h);
+    let water = harbour_expectation(&scene, w, h).unwrap();
     let options = RenderOptions {
         width: w,
         height: h,

@@ -128,7 +128,9 @@ pub struct SlopesUsed {
     /// across it (dimensionless).
     pub variance: [f32; 2],
     /// One-sigma uncertainty of the natural logarithm of each (about the relative
-    /// uncertainty); `None` where not estimated or not bracketed.
+    /// uncertainty), at least what one realisation of the waves moves it by
+    /// ([`crate::fitting::slopes::SLOPE_REALISATION_LN`]); `None` where not estimated or not
+    /// bracketed.
     pub sigma_ln: [Option<f32>; 2],
     /// Where the estimate started.
     pub start_variance: [f32; 2],

@@ -28,6 +28,7 @@ pub mod realisation;
 #[cfg(test)]
 pub(crate) use fixture::{fixture, load_fixture, Fixture};
 pub mod shapes;
+pub mod streak_slopes;
 pub mod water_surface;
 
 use std::path::{Path, PathBuf};

@@ -55,6 +55,5 @@ pub use gltf_builder::{flat_grid, paper_setup, TestScene};
 /// A fitted light against the sample light it stands for.
 pub mod truth;
 
-/// A scene's water flattened, the pixels that see the water, the harbour waves' expectation
-/// and a wave mesh's slopes under the streaks.
+/// A scene's water flattened to its mean level.
 pub mod water;

@@ -71,6 +71,7 @@ use newton::newton_along;
 
 pub use uncertainty::{
     correlation_area, parameter_slopes, realisation_floor, widen, MAX_LAG, REALISATION_FLUX,
+    SLOPE_REALISATION_LN,
 };
 
 use super::gloss::search::{search, Point, Stop};
@@ -126,8 +127,8 @@ pub struct SlopeEstimate {
     /// The total slope variances along and across (dimensionless).
     pub variance: [f32; 2],
     /// One-sigma uncertainty of the natural logarithm of each (about the relative
-    /// uncertainty), from the cost's curvature grown by the residual's correlation; `None`
-    /// where the minimum was not bracketed.
+    /// uncertainty), from the cost's curvature grown by the residual's correlation, and at
+    /// least [`SLOPE_REALISATION_LN`]; `None` where the minimum was not bracketed.
     pub sigma_ln: [Option<f32>; 2],
     /// Where the search started.
     pub start_variance: [f32; 2],
@@ -556,6 +557,8 @@ pub fn estimate_slopes(
     );
     let radiance: Vec<[f32; 3]> = lights.iter().map(|l| l.radiance).collect();
     realisation_floor(&mut uncertainty, &radiance);
+    // Reported as what the photo tells of the water under its streaks.
+    let sigma_ln = [0, 1].map(|a| sigma_ln[a].map(|s| s.max(SLOPE_REALISATION_LN[a])));
     Ok(SlopeEstimate {
         water: at,
         variance,

@@ -93,6 +93,18 @@ pub fn correlation_area(
 /// one sigma: the largest, 20.0 % low, is 2.5 sigmas of the radiance it was fitted at.
 pub const REALISATION_FLUX: f64 = 0.10;
 
+/// The uncertainty, at least, of the natural logarithm of each slope variance estimated from
+/// the photo (along, across the view), as a description of the water the streaks reflect: the
+/// search's own sigma is the photo's noise about the best Gaussian lobe, and says nothing of
+/// how far one realisation's waves under a streak are from a Gaussian lobe. Measured by
+/// `cargo bench --bench realisations` (BENCHMARKS.md): over 16 wave fields of the harbour's
+/// statistics, the sign's estimates against each field's mesh under its streak
+/// ([`crate::samples::streak_slopes::lobe_under_streaks`]) were off by 0.24 (along) and 0.43
+/// (across) in the logarithm, rms, where the search's sigmas were 0.03-0.11 and 0.05-0.33: up
+/// to 12.8 sigmas off. The lights do not take this on (`widen` carries the search's own
+/// sigma into them): their scatter over realisations is [`REALISATION_FLUX`]'s.
+pub const SLOPE_REALISATION_LN: [f32; 2] = [0.24, 0.43];
+
 /// Every radiance sigma of a light whose radiance the reflections alone give (not
 /// [`Uncertainty::radiance_seen`]) raised to at least [`REALISATION_FLUX`] of that radiance
 /// (`radiance`: per light, in the order of `uncertainty`). The floor is rounded down to an
