@@ -9,8 +9,8 @@
 //! quad, so what scatters is the waves, not the scene. Per seed it prints the brightest
 //! channel's radiance error (% of the truth) and that error in reported sigmas, then their
 //! root mean square, mean and largest, and how many seeds' fits gave more lights than the
-//! truth holds. For the harbour's sign it also holds the fit's slope variances against the
-//! ones of that realisation's mesh under the sign's streak
+//! truth holds. At the harbour it also holds the fit's slope variances against the ones of
+//! that realisation's mesh under the streaks
 //! ([`streaklight::samples::streak_slopes::lobe_under_streaks`]): per axis the error in %
 //! and in reported sigmas, then their root mean square, mean and largest, and how many lie
 //! within 15 %.
@@ -18,8 +18,10 @@
 //! `cargo bench --bench realisations` runs 16 seeds of the harbour's warm white sign (6 x
 //! 1.2 m, 40 m from a camera 2 m above the water, its image clipped in every channel) and of
 //! Table 1's lamp (0.5-1 m in front of a camera 0.2 m above the water, its image clipped).
+//! `REALISATION_CASES=pair` runs the harbour's pair in frame (an orange and a blue lamp whose
+//! images leave channels unclipped), for its slope variances.
 //! Environment: `REALISATION_SEEDS` (count), `REALISATION_CASES` (comma-separated: "sign",
-//! "table1"), `REALISATION_SPP` (camera rays per pixel of the renders; the samples' 256 by
+//! "pair", "table1"), `REALISATION_SPP` (camera rays per pixel of the renders; the samples' 256 by
 //! default).
 
 use std::path::{Path, PathBuf};
@@ -33,12 +35,14 @@ use streaklight::samples::realisation::write_over_waves;
 use streaklight::samples::streak_slopes::lobe_under_streaks;
 use streaklight::samples::{self, SampleLight, PHOTO_EXPOSURE, PHOTO_SIZE};
 
-/// One case: the truth scene rendered, the scene fitted against, and the truth lights.
+/// One case: the truth scene rendered, the scene fitted against, the truth lights, and
+/// whether it is the harbour's (whose slope variances are held against the mesh's).
 struct Case {
     name: &'static str,
     truth: &'static str,
     fitted_against: &'static str,
     lights: Vec<SampleLight>,
+    harbour: bool,
 }
 
 fn case(name: &str) -> Case {
@@ -55,14 +59,23 @@ fn case(name: &str) -> Case {
             truth: "harbour-sign-truth.gltf",
             fitted_against: "harbour-flat.gltf",
             lights: truth("harbour-sign-truth.gltf"),
+            harbour: true,
+        },
+        "pair" => Case {
+            name: "pair",
+            truth: "harbour-pair-truth.gltf",
+            fitted_against: "harbour-flat.gltf",
+            lights: truth("harbour-pair-truth.gltf"),
+            harbour: true,
         },
         "table1" => Case {
             name: "table1",
             truth: "table1-truth.gltf",
             fitted_against: "scene-flat.gltf",
             lights: truth("table1-truth.gltf"),
+            harbour: false,
         },
-        other => panic!("REALISATION_CASES: no case {other} (sign, table1)"),
+        other => panic!("REALISATION_CASES: no case {other} (sign, pair, table1)"),
     }
 }
 
@@ -211,8 +224,8 @@ struct Slopes {
 }
 
 /// Renders `case`'s truth over the waves of `seed` as the sample photos are, fits the photo
-/// against the case's flat quad at the defaults, and returns the report's lights and, for the
-/// harbour's sign, its slope variances against the realisation's mesh's.
+/// against the case's flat quad at the defaults, and returns the report's lights and, at the
+/// harbour, its slope variances against the realisation's mesh's.
 fn fit_realisation(dir: &Path, case: &Case, seed: u64, spp: u32) -> Fitted {
     let here = dir.join(format!("{}-{seed}", case.name));
     let truth = write_over_waves(case.truth, seed, &here).expect("writing the truth's scene");
@@ -239,7 +252,8 @@ fn fit_realisation(dir: &Path, case: &Case, seed: u64, spp: u32) -> Fitted {
         ..ConvertOptions::new(dir.join(case.fitted_against), &photo, here.join("lit.gltf"))
     };
     let report = convert(&options).expect("fit").report;
-    let slopes = (case.name == "sign")
+    let slopes = case
+        .harbour
         .then_some(report.water_model.slopes.as_ref())
         .flatten()
         .map(|s| Slopes {
