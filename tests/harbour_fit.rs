@@ -116,29 +116,36 @@ fn assert_layout(layout: &str, scene: &Scene, lit: &Lit) {
 /// once per layout.
 fn mesh_under_streaks(layout: &str) -> [f64; 2] {
     use std::collections::HashMap;
-    use std::sync::{Mutex, OnceLock};
-    static MADE: OnceLock<Mutex<HashMap<String, [f64; 2]>>> = OnceLock::new();
-    let made = MADE.get_or_init(Default::default);
-    if let Some(v) = made.lock().unwrap().get(layout) {
-        return *v;
-    }
-    let scene = sample_scene(&format!("harbour-{layout}-truth.gltf"), None);
-    let photo = sample_photo(&format!("harbour-{layout}.png"));
-    let total = lobe_under_streaks(
-        &scene,
-        photo.width,
-        photo.height,
-        harbour::HARBOUR_GLOSS,
-        MICROFACET_GLOSS as f64,
-    )
-    .unwrap();
-    println!(
-        "{layout}: the mesh's slope variances under the streaks {:.3e} along, {:.3e} across \
-         (the lobe's whole, less the model's microfacets)",
-        total[0], total[1]
-    );
-    made.lock().unwrap().insert(layout.to_string(), total);
-    total
+    use std::sync::{Arc, Mutex, OnceLock};
+    type Made = Mutex<HashMap<String, Arc<OnceLock<[f64; 2]>>>>;
+    static MADE: OnceLock<Made> = OnceLock::new();
+    // One cell per layout, taken under the lock and filled outside it: tests of other
+    // layouts measure at the same time, tests of the same one wait for the first.
+    let cell = MADE
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap()
+        .entry(layout.to_string())
+        .or_default()
+        .clone();
+    *cell.get_or_init(|| {
+        let scene = sample_scene(&format!("harbour-{layout}-truth.gltf"), None);
+        let photo = sample_photo(&format!("harbour-{layout}.png"));
+        let total = lobe_under_streaks(
+            &scene,
+            photo.width,
+            photo.height,
+            harbour::HARBOUR_GLOSS,
+            MICROFACET_GLOSS as f64,
+        )
+        .unwrap();
+        println!(
+            "{layout}: the mesh's slope variances under the streaks {:.3e} along, {:.3e} \
+             across (the lobe's whole, less the model's microfacets)",
+            total[0], total[1]
+        );
+        total
+    })
 }
 
 /// The slope variances the fit `lit` of harbour layout `layout`'s photo (lamps in frame)

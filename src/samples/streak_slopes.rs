@@ -5,6 +5,7 @@
 //! the pixels where each light's reflection in the harbour waves' expected image passes 2 %
 //! of its peak, with the mesh's shading normals against the mean plane's axes.
 
+use crate::optics::GaussianSlopes;
 use crate::render::{camera_hit, render_with_lights, CameraHit, RenderOptions};
 use crate::scene_in::Scene;
 use crate::water_model::{water_statistics, StatisticalSurface};
@@ -139,7 +140,7 @@ pub fn lobe_under_streaks(
         .ok_or_else(|| Error::NothingFound("the camera sees no water".into()))?;
     let pixels = streak_footprints(scene, &water, w, h)?;
     let mesh = mesh_slope_variances(scene, &water, &pixels, w, h)?;
-    let micro = |gloss: f64| 1.0 / (gloss + 2.0);
+    let micro = |gloss: f64| GaussianSlopes::from_gloss(gloss as f32).variance[0] as f64;
     Ok(mesh.map(|v| v + micro(photo_gloss) - micro(model_gloss)))
 }
 
